@@ -1,0 +1,22 @@
+"""assocopt: data association for multi-sensor tracking as optimisation models.
+
+>>> from assocopt import AssignmentProblem, solve
+>>> sol = solve(AssignmentProblem.dense([[4.0, 1.0], [2.0, 3.0]]))
+>>> sol.objective
+3.0
+"""
+
+from .errors import (AssocoptError, InstanceFormatError, InvalidProblemError,
+                     ProblemTooLargeError, SolverCapabilityError,
+                     SolverNotInstalledError, UnknownSolverError)
+from .problem import AssignmentProblem
+from .solution import Solution, Status
+from . import solvers
+from .api import choose_solver, solve
+
+__version__ = "0.1.0"
+
+__all__ = ["AssignmentProblem", "Solution", "Status", "solve", "choose_solver", "solvers",
+           "AssocoptError", "InvalidProblemError", "InstanceFormatError",
+           "UnknownSolverError", "SolverNotInstalledError", "SolverCapabilityError",
+           "ProblemTooLargeError", "__version__"]

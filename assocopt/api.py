@@ -1,0 +1,163 @@
+"""``solve``: one entry point for every problem, formulation and back end."""
+
+from __future__ import annotations
+
+import math
+import time
+from typing import Any
+
+import numpy as np
+
+from .errors import InvalidProblemError, SolverCapabilityError
+from .formulation import RELAXATIONS
+from .problem import AssignmentProblem
+from .solution import Solution, Status
+from .solvers.base import Backend, RawResult, SolveOptions, get_backend
+
+__all__ = ["solve", "choose_solver"]
+
+
+def choose_solver(problem: AssignmentProblem, relax: str | None = None) -> str:
+    """The back end ``solver="auto"`` picks: the 2-D fast path or HiGHS."""
+    if relax is None and problem.ndim == 2:
+        return "scipy-lsa"
+    return "highs"
+
+
+def solve(problem: AssignmentProblem, solver: str = "auto", *, relax: str | None = None,
+          time_limit: float | None = None, mip_gap: float = 0.0,
+          threads: int | None = None, verbose: bool = False,
+          **options: Any) -> Solution:
+    """Solve ``problem`` with the back end ``solver``.
+
+    Parameters
+    ----------
+    problem : AssignmentProblem
+    solver : str
+        A name from :func:`assocopt.solvers.available` or ``"auto"``.
+    relax : None or "lp"
+        ``"lp"`` solves the LP relaxation: ``objective`` is the LP optimum (a lower
+        bound on the ILP), ``x`` the fractional solution, ``integral`` whether it
+        happens to be integral (then ``tuples`` is filled too).
+    time_limit : float, optional
+        Seconds, for back ends that support a limit.
+    mip_gap : float
+        Relative gap at which MIP back ends may stop (default 0: proven optimum).
+    threads : int, optional
+        Threads for back ends that use them.
+    **options
+        Back-end specific options (see each back end's docstring).
+
+    Returns
+    -------
+    Solution
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from assocopt import AssignmentProblem, solve
+    >>> sol = solve(AssignmentProblem.dense([[4.0, 1.0], [2.0, 3.0]]), solver="highs")
+    >>> sol.status.value, sol.objective, sol.assignment()
+    ('optimal', 3.0, (array([0, 1]), array([1, 0])))
+    """
+    t0 = time.perf_counter()
+    if not isinstance(problem, AssignmentProblem):
+        raise InvalidProblemError(
+            f"problem must be an AssignmentProblem, got {type(problem).__name__}")
+    if relax not in RELAXATIONS:
+        raise InvalidProblemError(f"relax must be None or 'lp', got {relax!r}")
+    _check_limits(time_limit, mip_gap, threads)
+    name = choose_solver(problem, relax) if solver == "auto" else solver
+    backend_cls = get_backend(name)
+    _check_capabilities(backend_cls, problem, relax)
+    backend_cls.require()
+    opts = SolveOptions(relax=relax, time_limit=time_limit, mip_gap=float(mip_gap),
+                        threads=threads, verbose=verbose, extra=dict(options))
+
+    missing = problem.uncovered()
+    if missing:
+        a, i = missing[0]
+        more = f" (and {len(missing) - 1} more)" if len(missing) > 1 else ""
+        raw = RawResult(Status.INFEASIBLE,
+                        message=f"infeasible: index {i} of axis {a} is covered by no "
+                                f"candidate{more}",
+                        info={"uncovered": missing[:20]})
+    elif problem.n_rows == 0:
+        raw = RawResult(Status.OPTIMAL, selected=np.zeros(0, np.int64),
+                        x=np.zeros(problem.n_candidates) if relax else None,
+                        bound=0.0, objective=0.0, message="empty problem")
+    else:
+        raw = backend_cls().solve(problem, opts)
+    sol = _finalise(problem, backend_cls, raw, relax)
+    sol.times["total"] = time.perf_counter() - t0
+    return sol
+
+
+def _check_limits(time_limit: float | None, mip_gap: float, threads: int | None) -> None:
+    if time_limit is not None and not (isinstance(time_limit, (int, float))
+                                       and time_limit > 0 and not math.isnan(time_limit)):
+        raise InvalidProblemError(f"time_limit must be a positive number, got {time_limit!r}")
+    if not (isinstance(mip_gap, (int, float)) and 0 <= mip_gap < math.inf):
+        raise InvalidProblemError(f"mip_gap must be a number >= 0, got {mip_gap!r}")
+    if threads is not None and not (isinstance(threads, int) and threads >= 1):
+        raise InvalidProblemError(f"threads must be a positive integer, got {threads!r}")
+
+
+def _check_capabilities(cls: type[Backend], problem: AssignmentProblem,
+                        relax: str | None) -> None:
+    if relax == "lp" and not cls.lp:
+        raise SolverCapabilityError(f"solver {cls.name!r} cannot solve LP relaxations")
+    if relax is None and not cls.integer:
+        raise SolverCapabilityError(f"solver {cls.name!r} solves LP relaxations only; "
+                                    "pass relax='lp'")
+    if cls.max_ndim is not None and problem.ndim > cls.max_ndim:
+        raise SolverCapabilityError(
+            f"solver {cls.name!r} handles problems of at most {cls.max_ndim} axes, "
+            f"this one has {problem.ndim}")
+
+
+_INTEGRAL_TOL = 1e-6
+
+
+def _finalise(problem: AssignmentProblem, cls: type[Backend], raw: RawResult,
+              relax: str | None) -> Solution:
+    """Common post-processing: never trust a back end's claim without checking it."""
+    sol = Solution(status=raw.status, bound=raw.bound, solver=cls.name,
+                   solver_version=cls.version(), relaxation=relax,
+                   message=raw.message, info=dict(raw.info),
+                   times={"build": raw.build_time, "solve": raw.solve_time})
+    if relax == "lp":
+        _finalise_lp(problem, raw, sol)
+    elif raw.selected is not None:
+        sel = np.sort(np.asarray(raw.selected, dtype=np.int64))
+        why = problem.violations(sel)
+        if why is not None:
+            sol.status = Status.ERROR
+            sol.message = f"back end returned an infeasible assignment: {why}"
+            return sol
+        sol.selected = sel
+        sol.objective = problem.objective_of(sel)
+    if sol.objective is not None and sol.bound is not None and sol.bound > sol.objective:
+        sol.bound = sol.objective   # tolerance noise: a lower bound never exceeds the optimum
+    if sol.status is Status.OPTIMAL and sol.bound is None and cls.exact:
+        sol.bound = sol.objective
+    if sol.selected is not None:
+        sol.tuples = problem.tuples[sol.selected[~problem.slack[sol.selected]]].copy()
+    return sol
+
+
+def _finalise_lp(problem: AssignmentProblem, raw: RawResult, sol: Solution) -> None:
+    if raw.x is None:
+        return
+    x = np.clip(np.asarray(raw.x, dtype=np.float64), 0.0, 1.0)
+    sol.x = x
+    sol.objective = float(problem.costs @ x)
+    if raw.status is Status.OPTIMAL:
+        sol.bound = sol.objective
+    frac = np.abs(x - np.round(x))
+    sol.integral = bool(frac.max(initial=0.0) <= _INTEGRAL_TOL)
+    if sol.integral:
+        sel = np.flatnonzero(x > 0.5)
+        if problem.violations(sel) is None:
+            sol.selected = sel
+            sol.objective = problem.objective_of(sel)

@@ -1,0 +1,361 @@
+"""The assignment problem: one sparse S-D cost tensor for every case.
+
+Notation (SPEC.md 002.2): there are N index sets ("axes": sensors, or rows and
+columns in 2-D) of sizes ``n_1 .. n_N``.  A *candidate tuple* ``(i_1, ..., i_N)``
+picks one index per axis; ``i_s = 0`` is the **dummy** (missed detection / not
+assigned) and ``1 .. n_s`` are the real indices.  A feasible solution chooses
+candidates so that **every real index of every axis is covered exactly once**; the
+dummy may be reused by any number of tuples; the all-dummy tuple is never a
+candidate.  The objective is the sum of the chosen candidates' costs.
+
+Every user-facing case is stored in this one form:
+
+* ``AssignmentProblem.dense(C)`` -- axial N-D (N >= 2) on a full cost array.  With
+  unequal sizes the smallest axis is fully assigned and the other axes' surplus
+  indices stay free (scipy's rectangular ``linear_sum_assignment`` semantics): they
+  are covered by zero-cost *slack* candidates, which solutions never report.
+* ``AssignmentProblem.two_d(C, row_miss, col_miss)`` -- 2-D with non-assignment
+  costs: ``(i, 0)`` costs ``row_miss[i]``, ``(0, j)`` costs ``col_miss[j]``.
+* ``AssignmentProblem.sparse(sizes, tuples, costs)`` -- general S-D with dummies.
+
+``+inf`` costs mean "forbidden": such candidates are dropped and never reach a
+solver.  NaN and ``-inf`` are errors.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from typing import Any, Sequence
+
+import numpy as np
+import scipy.sparse as sp
+from numpy.typing import ArrayLike
+
+from .errors import InvalidProblemError
+
+__all__ = ["AssignmentProblem"]
+
+#: Largest number of candidates a dense constructor will enumerate.
+MAX_DENSE_CANDIDATES = 50_000_000
+
+
+def _as_cost_array(values: ArrayLike, what: str) -> np.ndarray:
+    """Return ``values`` as float64, rejecting NaN and -inf (``+inf`` = forbidden)."""
+    try:
+        arr = np.array(values, dtype=np.float64)
+    except (TypeError, ValueError) as exc:
+        raise InvalidProblemError(f"{what} must be numeric: {exc}") from exc
+    if np.isnan(arr).any():
+        where = tuple(int(i) for i in np.argwhere(np.isnan(arr))[0])
+        raise InvalidProblemError(f"{what} contains NaN (first at index {where})")
+    if np.isneginf(arr).any():
+        where = tuple(int(i) for i in np.argwhere(np.isneginf(arr))[0])
+        raise InvalidProblemError(f"{what} contains -inf (first at index {where})")
+    return arr
+
+
+def _freeze(arr: np.ndarray) -> np.ndarray:
+    arr.setflags(write=False)
+    return arr
+
+
+@dataclass(frozen=True, eq=False)
+class AssignmentProblem:
+    """A validated S-D assignment problem (see the module docstring for the model).
+
+    Build it with :meth:`dense`, :meth:`two_d` or :meth:`sparse`, not directly.
+
+    Attributes
+    ----------
+    sizes : tuple of int
+        ``n_s``, the number of real indices on each axis.
+    tuples : ndarray of int64, shape (K, N)
+        Candidate tuples; ``0`` is the dummy, real indices are ``1..n_s``.
+    costs : ndarray of float64, shape (K,)
+        Finite candidate costs.
+    slack : ndarray of bool, shape (K,)
+        Candidates added by :meth:`dense` to leave surplus indices free; they
+        cost 0 and are left out of reported solutions.
+    kind : str
+        ``"dense"``, ``"two_d"`` or ``"sparse"``: how the problem was built.
+    name : str or None
+    optimum : float or None
+        A recorded, proven optimum (from an instance file), used for checks only.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> p = AssignmentProblem.dense(np.array([[4.0, 1.0], [2.0, 3.0]]))
+    >>> p.sizes, p.n_candidates
+    ((2, 2), 4)
+    """
+
+    sizes: tuple[int, ...]
+    tuples: np.ndarray
+    costs: np.ndarray
+    slack: np.ndarray
+    kind: str = "sparse"
+    name: str | None = None
+    optimum: float | None = None
+    meta: dict[str, Any] = field(default_factory=dict)
+
+    # ------------------------------------------------------------------ builders
+    @classmethod
+    def dense(cls, costs: ArrayLike, *, name: str | None = None,
+              optimum: float | None = None) -> "AssignmentProblem":
+        """Axial assignment on a full ``n_1 x ... x n_N`` cost array (N >= 2).
+
+        The smallest axis is assigned completely; surplus indices of larger axes
+        stay unassigned at no cost.  ``+inf`` entries are forbidden tuples.
+        """
+        C = _as_cost_array(costs, "cost array")
+        if C.ndim < 2:
+            raise InvalidProblemError(
+                f"cost array must have at least 2 dimensions, got shape {C.shape}")
+        if C.size > MAX_DENSE_CANDIDATES:
+            raise InvalidProblemError(
+                f"cost array of shape {C.shape} has {C.size} entries, more than "
+                f"{MAX_DENSE_CANDIDATES}; build a sparse problem of the gated candidates")
+        sizes = tuple(int(n) for n in C.shape)
+        finite = np.isfinite(C)
+        real = np.stack(np.nonzero(finite), axis=1).astype(np.int64) + 1
+        tuples = [real]
+        costs_list = [C[finite]]
+        n_min = min(sizes)
+        # Slack singletons leave the surplus indices of larger axes free.
+        for axis, n in enumerate(sizes):
+            if n > n_min:
+                t = np.zeros((n, len(sizes)), dtype=np.int64)
+                t[:, axis] = np.arange(1, n + 1)
+                tuples.append(t)
+                costs_list.append(np.zeros(n))
+        slack = np.zeros(sum(len(c) for c in costs_list), dtype=bool)
+        slack[len(costs_list[0]):] = True
+        return cls._build(sizes, np.concatenate(tuples), np.concatenate(costs_list),
+                          slack, kind="dense", name=name, optimum=optimum)
+
+    @classmethod
+    def two_d(cls, costs: ArrayLike, row_miss: ArrayLike | None = None,
+              col_miss: ArrayLike | None = None, *, name: str | None = None,
+              optimum: float | None = None) -> "AssignmentProblem":
+        """2-D assignment of an ``n1 x n2`` cost matrix with non-assignment costs.
+
+        Row ``i`` left unassigned costs ``row_miss[i]``, column ``j`` costs
+        ``col_miss[j]`` (scalars broadcast).  ``inf`` forbids leaving it
+        unassigned.  With neither given this is :meth:`dense` (the smaller side
+        fully assigned); with only one given, the other side must be assigned.
+        """
+        C = _as_cost_array(costs, "cost matrix")
+        if C.ndim != 2:
+            raise InvalidProblemError(f"cost matrix must be 2-D, got shape {C.shape}")
+        if row_miss is None and col_miss is None:
+            return cls.dense(C, name=name, optimum=optimum)
+        n1, n2 = C.shape
+        rm = np.full(n1, np.inf) if row_miss is None else cls._miss(row_miss, n1, "row_miss")
+        cm = np.full(n2, np.inf) if col_miss is None else cls._miss(col_miss, n2, "col_miss")
+        finite = np.isfinite(C)
+        pairs = np.stack(np.nonzero(finite), axis=1).astype(np.int64) + 1
+        r = np.flatnonzero(np.isfinite(rm))
+        c = np.flatnonzero(np.isfinite(cm))
+        row_t = np.stack([r + 1, np.zeros_like(r)], axis=1)
+        col_t = np.stack([np.zeros_like(c), c + 1], axis=1)
+        tuples = np.concatenate([pairs, row_t, col_t]).astype(np.int64)
+        costs_ = np.concatenate([C[finite], rm[r], cm[c]])
+        return cls._build((n1, n2), tuples, costs_, np.zeros(len(costs_), bool),
+                          kind="two_d", name=name, optimum=optimum)
+
+    @staticmethod
+    def _miss(values: ArrayLike, n: int, what: str) -> np.ndarray:
+        arr = _as_cost_array(values, what)
+        if arr.ndim == 0:
+            return np.full(n, float(arr))
+        if arr.shape != (n,):
+            raise InvalidProblemError(f"{what} must be a scalar or have shape ({n},), "
+                                      f"got shape {arr.shape}")
+        return arr
+
+    @classmethod
+    def sparse(cls, sizes: Sequence[int], tuples: ArrayLike, costs: ArrayLike, *,
+               name: str | None = None, optimum: float | None = None) -> "AssignmentProblem":
+        """General S-D problem from candidate tuples (index 0 = dummy) and costs.
+
+        Candidates with ``+inf`` cost are dropped.  Indices must be integers in
+        ``0..n_s``; duplicate tuples and the all-dummy tuple are errors.
+        """
+        sizes_t = cls._check_sizes(sizes)
+        N = len(sizes_t)
+        T = cls._check_tuples(tuples, sizes_t)
+        c = _as_cost_array(costs, "costs")
+        if c.ndim != 1 or len(c) != len(T):
+            raise InvalidProblemError(
+                f"costs must have shape ({len(T)},) to match tuples of shape "
+                f"({len(T)}, {N}), got shape {c.shape}")
+        keep = np.isfinite(c)
+        T, c = T[keep], c[keep]
+        return cls._build(sizes_t, T, c, np.zeros(len(c), bool), kind="sparse",
+                          name=name, optimum=optimum)
+
+    @staticmethod
+    def _check_sizes(sizes: Sequence[int]) -> tuple[int, ...]:
+        try:
+            arr = np.asarray(sizes)
+        except (TypeError, ValueError) as exc:
+            raise InvalidProblemError(f"sizes must be a sequence of integers: {exc}") from exc
+        if arr.ndim != 1 or len(arr) < 2:
+            raise InvalidProblemError(
+                f"sizes must list at least 2 axes, got {list(np.atleast_1d(arr))}")
+        if arr.dtype.kind not in "iuf" or (arr.dtype.kind == "f" and
+                                           not np.all(arr == np.round(arr))):
+            raise InvalidProblemError(f"sizes must be integers, got {arr.tolist()}")
+        if (arr < 0).any():
+            raise InvalidProblemError(f"sizes must be non-negative, got {arr.tolist()}")
+        return tuple(int(n) for n in arr)
+
+    @staticmethod
+    def _check_tuples(tuples: ArrayLike, sizes: tuple[int, ...]) -> np.ndarray:
+        N = len(sizes)
+        try:
+            raw = np.asarray(tuples)
+        except (TypeError, ValueError) as exc:
+            raise InvalidProblemError(f"tuples must be an integer array: {exc}") from exc
+        if raw.size == 0:
+            raw = raw.reshape(0, N)
+        if raw.ndim != 2 or raw.shape[1] != N:
+            raise InvalidProblemError(
+                f"tuples must have shape (K, {N}) for {N} axes, got shape {raw.shape}")
+        if raw.dtype.kind == "f":
+            if not np.all(np.isfinite(raw)) or not np.all(raw == np.round(raw)):
+                bad = int(np.argwhere(~np.isfinite(raw) | (raw != np.round(raw)))[0, 0])
+                raise InvalidProblemError(
+                    f"tuple {bad} has a non-integer index: {raw[bad].tolist()}")
+        elif raw.dtype.kind not in "iub":
+            raise InvalidProblemError(f"tuples must be integers, got dtype {raw.dtype}")
+        T = raw.astype(np.int64)
+        upper = np.asarray(sizes, dtype=np.int64)
+        bad_rows = np.flatnonzero(((T < 0) | (T > upper)).any(axis=1))
+        if len(bad_rows):
+            k = int(bad_rows[0])
+            raise InvalidProblemError(
+                f"tuple {k} = {T[k].tolist()} has an index out of range: axis s takes "
+                f"0 (dummy) .. n_s with sizes {list(sizes)}")
+        all_dummy = np.flatnonzero((T == 0).all(axis=1))
+        if len(all_dummy):
+            raise InvalidProblemError(
+                f"tuple {int(all_dummy[0])} is the all-dummy tuple {T[all_dummy[0]].tolist()}, "
+                "which is never a candidate (it covers no real index)")
+        if len(T) > 1:
+            _, first, counts = np.unique(T, axis=0, return_index=True, return_counts=True)
+            if (counts > 1).any():
+                dup = T[first[np.argmax(counts > 1)]]
+                raise InvalidProblemError(f"duplicate candidate tuple {dup.tolist()}")
+        return T
+
+    @classmethod
+    def _build(cls, sizes, tuples, costs, slack, **kw) -> "AssignmentProblem":
+        return cls(sizes=tuple(sizes), tuples=_freeze(np.ascontiguousarray(tuples, np.int64)),
+                   costs=_freeze(np.ascontiguousarray(costs, np.float64)),
+                   slack=_freeze(np.ascontiguousarray(slack, bool)), **kw)
+
+    # ------------------------------------------------------------- properties
+    @property
+    def ndim(self) -> int:
+        """N, the number of axes."""
+        return len(self.sizes)
+
+    @property
+    def n_candidates(self) -> int:
+        """K, the number of candidate tuples (slack included)."""
+        return len(self.costs)
+
+    @property
+    def n_rows(self) -> int:
+        """Number of coverage constraints: one per real index, ``sum(n_s)``."""
+        return int(sum(self.sizes))
+
+    @property
+    def row_offsets(self) -> np.ndarray:
+        """Row of real index 1 of each axis in the constraint matrix."""
+        return np.concatenate([[0], np.cumsum(self.sizes)[:-1]]).astype(np.int64)
+
+    def coverage_matrix(self) -> sp.csr_matrix:
+        """CSR matrix ``A`` (sum n_s x K): ``A[r, k] = 1`` if candidate k covers row r.
+
+        Row ``offset_s + i - 1`` stands for real index ``i`` of axis ``s``.
+        Built in bulk from the tuple array.
+        """
+        T = self.tuples
+        real = T > 0
+        rows = (T - 1 + self.row_offsets[None, :])[real]
+        cols = np.broadcast_to(np.arange(len(T))[:, None], T.shape)[real]
+        A = sp.csr_matrix((np.ones(len(rows)), (rows, cols)),
+                          shape=(self.n_rows, self.n_candidates))
+        A.sort_indices()
+        return A
+
+    def uncovered(self) -> list[tuple[int, int]]:
+        """Real indices ``(axis, index)`` that no candidate covers (1-based index).
+
+        Any such index makes the problem infeasible.
+        """
+        hit = np.zeros(self.n_rows, dtype=bool)
+        T = self.tuples
+        real = T > 0
+        hit[(T - 1 + self.row_offsets[None, :])[real]] = True
+        missing = np.flatnonzero(~hit)
+        axes = np.searchsorted(self.row_offsets, missing, side="right") - 1
+        return [(int(a), int(r - self.row_offsets[a] + 1)) for a, r in zip(axes, missing)]
+
+    def is_two_d(self) -> bool:
+        return self.ndim == 2
+
+    # ------------------------------------------------------------- solutions
+    def violations(self, selected: ArrayLike) -> str | None:
+        """Why ``selected`` (candidate positions) is not feasible, or None if it is."""
+        sel = np.asarray(selected, dtype=np.int64)
+        if sel.ndim != 1:
+            return "selection must be a 1-D array of candidate positions"
+        if len(sel) and (sel.min() < 0 or sel.max() >= self.n_candidates):
+            return "selection refers to a candidate that does not exist"
+        if len(np.unique(sel)) != len(sel):
+            return "a candidate is selected twice"
+        T = self.tuples[sel]
+        real = T > 0
+        count = np.bincount((T - 1 + self.row_offsets[None, :])[real],
+                            minlength=self.n_rows)
+        bad = np.flatnonzero(count != 1)
+        if len(bad):
+            r = int(bad[0])
+            a = int(np.searchsorted(self.row_offsets, r, side="right") - 1)
+            i = r - int(self.row_offsets[a]) + 1
+            return f"index {i} of axis {a} is covered {int(count[r])} times, not once"
+        return None
+
+    def objective_of(self, selected: ArrayLike) -> float:
+        """Sum of the costs of the selected candidates (math.fsum, exact rounding)."""
+        import math
+        return math.fsum(self.costs[np.asarray(selected, dtype=np.int64)].tolist())
+
+    def to_cost_matrix(self, fill: float = np.inf) -> np.ndarray:
+        """Dense array of the all-real candidates' costs (``fill`` elsewhere)."""
+        M = np.full(self.sizes, fill, dtype=np.float64)
+        real = (self.tuples > 0).all(axis=1)
+        M[tuple((self.tuples[real] - 1).T)] = self.costs[real]
+        return M
+
+    def miss_costs(self) -> tuple[np.ndarray, np.ndarray]:
+        """For a 2-D problem: ``(row_miss, col_miss)`` with ``inf`` where forbidden."""
+        if self.ndim != 2:
+            raise InvalidProblemError("miss costs are defined for 2-D problems only")
+        rm = np.full(self.sizes[0], np.inf)
+        cm = np.full(self.sizes[1], np.inf)
+        T = self.tuples
+        r = (T[:, 0] > 0) & (T[:, 1] == 0)
+        c = (T[:, 0] == 0) & (T[:, 1] > 0)
+        rm[T[r, 0] - 1] = self.costs[r]
+        cm[T[c, 1] - 1] = self.costs[c]
+        return rm, cm
+
+    def __repr__(self) -> str:
+        label = f" {self.name!r}" if self.name else ""
+        return (f"<AssignmentProblem{label} kind={self.kind} sizes={self.sizes} "
+                f"candidates={self.n_candidates}>")

@@ -1,0 +1,156 @@
+"""The small interface every back end implements, and the registry of back ends.
+
+A back end is a class with a ``name``, capability flags, ``is_available()`` (checked
+without importing the package), ``version()`` and ``solve(problem, options)``, which
+returns a :class:`RawResult` in terms of candidate positions.  Turning that into a
+:class:`~assocopt.solution.Solution` (recomputing the objective, checking
+feasibility, timing) is done once, in :mod:`assocopt.api`, for every back end.
+"""
+
+from __future__ import annotations
+
+import importlib.metadata
+import importlib.util
+from dataclasses import dataclass, field
+from typing import Any, ClassVar
+
+import numpy as np
+
+from ..errors import SolverNotInstalledError, UnknownSolverError
+from ..problem import AssignmentProblem
+from ..solution import Status
+
+__all__ = ["SolveOptions", "RawResult", "Backend", "register", "get_backend",
+           "registered", "available"]
+
+
+@dataclass(frozen=True)
+class SolveOptions:
+    """Options common to all back ends; ``extra`` holds back-end specific ones.
+
+    relax : None or "lp"
+        Solve the ILP, or its LP relaxation.
+    time_limit : float or None
+        Seconds; a back end stopped by it reports ``Status.TIME_LIMIT``.
+    mip_gap : float
+        Relative gap at which a MIP solver may stop (0 = prove optimality).  A
+        solution returned with a positive gap is ``FEASIBLE``, not ``OPTIMAL``,
+        unless the reached gap is 0.
+    threads : int or None
+        Worker threads for back ends that use them (None: the back end's default).
+    verbose : bool
+        Let the back end print its log.
+    """
+
+    relax: str | None = None
+    time_limit: float | None = None
+    mip_gap: float = 0.0
+    threads: int | None = None
+    verbose: bool = False
+    extra: dict[str, Any] = field(default_factory=dict)
+
+
+@dataclass
+class RawResult:
+    """What a back end hands back, before the common checks of :func:`assocopt.solve`.
+
+    ``selected``: candidate positions of an integral solution (or None);
+    ``x``: the LP values of all candidates (LP relaxations only);
+    ``bound``: a proven lower bound, if the method gives one;
+    ``objective``: the back end's own objective (used for LPs; for integral
+    solutions the objective is recomputed from the costs);
+    ``build_time`` / ``solve_time``: seconds spent building the back end's model
+    and inside the back end's solve call.
+    """
+
+    status: Status
+    selected: np.ndarray | None = None
+    x: np.ndarray | None = None
+    bound: float | None = None
+    objective: float | None = None
+    message: str = ""
+    info: dict[str, Any] = field(default_factory=dict)
+    build_time: float = 0.0
+    solve_time: float = 0.0
+
+
+class Backend:
+    """Base class of the back ends.  Subclasses set the class attributes and ``solve``.
+
+    Capability flags, checked by :func:`assocopt.solve` before dispatch:
+
+    ``integer``: solves the ILP; ``lp``: solves the LP relaxation; ``exact``: proves
+    optimality of the ILP; ``gives_bound``: reports a lower bound; ``max_ndim``:
+    largest N it accepts (None: any); ``supports_time_limit``.
+    """
+
+    name: ClassVar[str] = ""
+    module: ClassVar[str | None] = None         # import name checked by is_available
+    distribution: ClassVar[str | None] = None   # pip name for the install hint
+    description: ClassVar[str] = ""
+    integer: ClassVar[bool] = True
+    lp: ClassVar[bool] = False
+    exact: ClassVar[bool] = True
+    gives_bound: ClassVar[bool] = True
+    max_ndim: ClassVar[int | None] = None
+    supports_time_limit: ClassVar[bool] = False
+
+    @classmethod
+    def is_available(cls) -> bool:
+        """Whether the back end's package is installed (without importing it)."""
+        if cls.module is None:
+            return True
+        try:
+            return importlib.util.find_spec(cls.module) is not None
+        except (ImportError, ValueError):
+            return False
+
+    @classmethod
+    def version(cls) -> str:
+        """Version of the package doing the work ("" when not installed)."""
+        dist = cls.distribution or "assocopt"
+        try:
+            return importlib.metadata.version(dist)
+        except importlib.metadata.PackageNotFoundError:
+            return ""
+
+    @classmethod
+    def require(cls) -> None:
+        """Raise :class:`SolverNotInstalledError` naming the package if it is missing."""
+        if not cls.is_available():
+            raise SolverNotInstalledError(
+                f"solver {cls.name!r} needs the Python package {cls.distribution!r}: "
+                f"pip install {cls.distribution}")
+
+    def solve(self, problem: AssignmentProblem, options: SolveOptions) -> RawResult:
+        raise NotImplementedError
+
+
+_REGISTRY: dict[str, type[Backend]] = {}
+
+
+def register(cls: type[Backend]) -> type[Backend]:
+    """Class decorator: add a back end to the registry under ``cls.name``."""
+    if not cls.name:
+        raise ValueError("a back end needs a name")
+    _REGISTRY[cls.name] = cls
+    return cls
+
+
+def registered() -> dict[str, type[Backend]]:
+    """All registered back ends by name, installed or not."""
+    return dict(_REGISTRY)
+
+
+def get_backend(name: str) -> type[Backend]:
+    """The back end class called ``name``; unknown names list the valid ones."""
+    try:
+        return _REGISTRY[name]
+    except KeyError:
+        valid = ", ".join(sorted(_REGISTRY) + ["auto"])
+        raise UnknownSolverError(f"unknown solver {name!r}; valid names: {valid}") from None
+
+
+def available() -> list[str]:
+    """Names of the back ends whose packages are installed."""
+    return sorted(n for n, cls in _REGISTRY.items() if cls.is_available())
