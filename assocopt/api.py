@@ -10,7 +10,7 @@ import numpy as np
 
 from .errors import InvalidProblemError, SolverCapabilityError
 from .formulation import RELAXATIONS
-from .problem import AssignmentProblem
+from .problem import AssignmentProblem, index_label
 from .solution import Solution, Status
 from .solvers.base import Backend, RawResult, SolveOptions, get_backend
 
@@ -79,7 +79,7 @@ def solve(problem: AssignmentProblem, solver: str = "auto", *, relax: str | None
         a, i = missing[0]
         more = f" (and {len(missing) - 1} more)" if len(missing) > 1 else ""
         raw = RawResult(Status.INFEASIBLE,
-                        message=f"infeasible: index {i} of axis {a} is covered by no "
+                        message=f"infeasible: {index_label(a, i)} is covered by no "
                                 f"candidate{more}",
                         info={"uncovered": missing[:20]})
     elif problem.n_rows == 0:

@@ -54,6 +54,11 @@ def _as_cost_array(values: ArrayLike, what: str) -> np.ndarray:
     return arr
 
 
+def index_label(axis: int, index: int) -> str:
+    """``"index i of axis s"`` with the conventions spelled out (axis 0-based, index 1-based)."""
+    return f"real index {index} (1-based) of axis {axis} (0-based)"
+
+
 def _freeze(arr: np.ndarray) -> np.ndarray:
     arr.setflags(write=False)
     return arr
@@ -305,8 +310,10 @@ class AssignmentProblem:
         axes = np.searchsorted(self.row_offsets, missing, side="right") - 1
         return [(int(a), int(r - self.row_offsets[a] + 1)) for a, r in zip(axes, missing)]
 
-    def is_two_d(self) -> bool:
-        return self.ndim == 2
+    def row_label(self, row: int) -> str:
+        """Human-readable name of constraint row ``row``: its axis and real index."""
+        a = int(np.searchsorted(self.row_offsets, row, side="right") - 1)
+        return index_label(a, int(row - self.row_offsets[a] + 1))
 
     # ------------------------------------------------------------- solutions
     def violations(self, selected: ArrayLike) -> str | None:
@@ -325,9 +332,7 @@ class AssignmentProblem:
         bad = np.flatnonzero(count != 1)
         if len(bad):
             r = int(bad[0])
-            a = int(np.searchsorted(self.row_offsets, r, side="right") - 1)
-            i = r - int(self.row_offsets[a]) + 1
-            return f"index {i} of axis {a} is covered {int(count[r])} times, not once"
+            return f"{self.row_label(r)} is covered {int(count[r])} times, not once"
         return None
 
     def objective_of(self, selected: ArrayLike) -> float:
