@@ -1,0 +1,119 @@
+"""AssignmentProblem: construction, conventions and validation errors."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from assocopt import AssignmentProblem, InvalidProblemError, solve
+
+
+def test_dense_square_has_all_tuples_one_based():
+    p = AssignmentProblem.dense(np.arange(4.0).reshape(2, 2))
+    assert p.sizes == (2, 2)
+    assert p.tuples.tolist() == [[1, 1], [1, 2], [2, 1], [2, 2]]
+    assert p.costs.tolist() == [0, 1, 2, 3]
+    assert not p.slack.any()
+
+
+def test_dense_rectangular_adds_zero_cost_slack_on_larger_axes_only():
+    p = AssignmentProblem.dense(np.ones((2, 3, 4)))
+    slack = p.tuples[p.slack]
+    # axis 1 (size 3) and axis 2 (size 4) are larger than the smallest (2)
+    assert sorted(map(tuple, slack)) == sorted(
+        [(0, j, 0) for j in (1, 2, 3)] + [(0, 0, k) for k in (1, 2, 3, 4)])
+    assert (p.costs[p.slack] == 0).all()
+
+
+def test_rectangular_solution_reports_no_slack_and_matches_scipy():
+    from scipy.optimize import linear_sum_assignment
+    C = np.random.default_rng(3).random((3, 6))
+    sol = solve(AssignmentProblem.dense(C), "highs")
+    r, c = linear_sum_assignment(C)
+    assert sol.objective == pytest.approx(C[r, c].sum())
+    assert (sol.tuples > 0).all()
+    rows, cols = sol.assignment()
+    assert rows.tolist() == r.tolist() and cols.tolist() == c.tolist()
+
+
+def test_inf_means_forbidden_and_is_dropped():
+    C = np.array([[1.0, np.inf], [np.inf, 1.0]])
+    p = AssignmentProblem.dense(C)
+    assert p.n_candidates == 2 and np.isfinite(p.costs).all()
+    sp = AssignmentProblem.sparse((2, 2), [[1, 1], [2, 2], [1, 2]], [1.0, 2.0, np.inf])
+    assert sp.n_candidates == 2
+
+
+def test_two_d_miss_costs_make_dummy_tuples():
+    p = AssignmentProblem.two_d([[1.0, 2.0]], row_miss=[5.0], col_miss=[0.5, 0.25])
+    got = {tuple(t): c for t, c in zip(p.tuples.tolist(), p.costs)}
+    assert got == {(1, 1): 1.0, (1, 2): 2.0, (1, 0): 5.0, (0, 1): 0.5, (0, 2): 0.25}
+    rm, cm = p.miss_costs()
+    assert rm.tolist() == [5.0] and cm.tolist() == [0.5, 0.25]
+
+
+def test_two_d_without_misses_is_dense():
+    assert AssignmentProblem.two_d(np.ones((2, 3))).kind == "dense"
+
+
+def test_input_arrays_are_copied_and_frozen():
+    C = np.ones((2, 2))
+    p = AssignmentProblem.dense(C)
+    C[0, 0] = 99
+    assert p.costs.max() == 1
+    with pytest.raises(ValueError):
+        p.costs[0] = 5
+
+
+def test_coverage_matrix_rows_are_axis_offsets():
+    p = AssignmentProblem.sparse((2, 3), [[1, 0], [0, 3], [2, 1]], [1, 2, 3])
+    A = p.coverage_matrix().toarray()
+    assert A.shape == (5, 3)
+    assert A[:, 0].tolist() == [1, 0, 0, 0, 0]
+    assert A[:, 1].tolist() == [0, 0, 0, 0, 1]
+    assert A[:, 2].tolist() == [0, 1, 1, 0, 0]
+
+
+def test_uncovered_names_axis_and_index():
+    p = AssignmentProblem.sparse((2, 2), [[1, 1], [2, 1]], [1, 2])
+    assert p.uncovered() == [(1, 2)]
+
+
+@pytest.mark.parametrize("bad, match", [
+    (np.array([[1.0, np.nan]]), "NaN"),
+    (np.array([[1.0, -np.inf]]), "-inf"),
+    (np.array([1.0, 2.0]), "at least 2 dimensions"),
+    ([["a", "b"]], "numeric"),
+])
+def test_dense_rejects_bad_costs(bad, match):
+    with pytest.raises(InvalidProblemError, match=match):
+        AssignmentProblem.dense(bad)
+
+
+@pytest.mark.parametrize("sizes, tuples, costs, match", [
+    ((2, 2), [[1, 1]], [1.0, 2.0], r"costs must have shape \(1,\)"),
+    ((2, 2), [[1, 1, 1]], [1.0], r"shape \(K, 2\)"),
+    ((2, 2), [[1, 3]], [1.0], "out of range"),
+    ((2, 2), [[1, -1]], [1.0], "out of range"),
+    ((2, 2), [[1.5, 1]], [1.0], "non-integer"),
+    ((2, 2), [[0, 0]], [1.0], "all-dummy"),
+    ((2, 2), [[1, 1], [1, 1]], [1.0, 2.0], "duplicate candidate tuple"),
+    ((2, -1), [[1, 0]], [1.0], "non-negative"),
+    ((2,), [[1]], [1.0], "at least 2 axes"),
+    ((2, 2.5), [[1, 1]], [1.0], "integers"),
+    ((2, 2), [[1, 1]], [np.nan], "NaN"),
+])
+def test_sparse_validation(sizes, tuples, costs, match):
+    with pytest.raises(InvalidProblemError, match=match):
+        AssignmentProblem.sparse(sizes, tuples, costs)
+
+
+def test_miss_cost_shape_is_checked():
+    with pytest.raises(InvalidProblemError, match=r"row_miss must be a scalar or have shape \(2,\)"):
+        AssignmentProblem.two_d(np.ones((2, 2)), row_miss=[1.0, 2.0, 3.0])
+
+
+def test_violations_reports_double_cover():
+    p = AssignmentProblem.sparse((2, 2), [[1, 1], [2, 1], [2, 2]], [1, 1, 1])
+    assert "covered 2 times" in p.violations([0, 1])
+    assert p.violations([0, 2]) is None
