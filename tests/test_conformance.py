@@ -27,9 +27,25 @@ def _kinds_for(name: str) -> tuple[str, ...]:
 
 @pytest.mark.parametrize("name", [installed(n) for n in EXACT])
 def test_exact_backend_equals_brute_force(name):
-    @given(problems(_kinds_for(name)))
+    integer = None if registered()[name].exact_float_costs else True
+
+    @given(problems(_kinds_for(name), integer=integer))
     def check(p):
         assert_optimal(p, solve(p, name))
+    check()
+
+
+@pytest.mark.parametrize("name", [installed(n) for n, cls in registered().items()
+                                  if cls.exact and not cls.exact_float_costs])
+def test_scaled_backend_within_its_reported_bound_on_float_costs(name):
+    @given(problems(_kinds_for(name), integer=False))
+    def check(p):
+        sol = solve(p, name)
+        ref = solve(p, "bruteforce").objective
+        assert sol.status in (Status.OPTIMAL, Status.FEASIBLE), sol.message
+        assert_feasible(p, sol)
+        assert sol.bound is not None and sol.bound <= ref + 1e-9
+        assert sol.objective - ref <= sol.objective - sol.bound + 1e-9
     check()
 
 

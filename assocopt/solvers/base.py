@@ -81,7 +81,9 @@ class Backend:
 
     ``integer``: solves the ILP; ``lp``: solves the LP relaxation; ``exact``: proves
     optimality of the ILP; ``gives_bound``: reports a lower bound; ``max_ndim``:
-    largest N it accepts (None: any); ``supports_time_limit``.
+    largest N it accepts (None: any); ``supports_time_limit``;
+    ``exact_float_costs``: proves optimality for arbitrary float costs, not only for
+    integer ones (False for CP-SAT, which scales costs to integers).
     """
 
     name: ClassVar[str] = ""
@@ -94,6 +96,7 @@ class Backend:
     gives_bound: ClassVar[bool] = True
     max_ndim: ClassVar[int | None] = None
     supports_time_limit: ClassVar[bool] = False
+    exact_float_costs: ClassVar[bool] = True
 
     @classmethod
     def is_available(cls) -> bool:
