@@ -9,6 +9,7 @@ feasibility, timing) is done once, in :mod:`assocopt.api`, for every back end.
 
 from __future__ import annotations
 
+import functools
 import importlib.metadata
 import importlib.util
 from dataclasses import dataclass, field
@@ -74,6 +75,15 @@ class RawResult:
     solve_time: float = 0.0
 
 
+@functools.lru_cache(maxsize=None)
+def _distribution_version(dist: str) -> str:
+    """Installed version of ``dist``; cached: reading metadata costs milliseconds."""
+    try:
+        return importlib.metadata.version(dist)
+    except importlib.metadata.PackageNotFoundError:
+        return ""
+
+
 class Backend:
     """Base class of the back ends.  Subclasses set the class attributes and ``solve``.
 
@@ -111,11 +121,7 @@ class Backend:
     @classmethod
     def version(cls) -> str:
         """Version of the package doing the work ("" when not installed)."""
-        dist = cls.distribution or "assocopt"
-        try:
-            return importlib.metadata.version(dist)
-        except importlib.metadata.PackageNotFoundError:
-            return ""
+        return _distribution_version(cls.distribution or "assocopt")
 
     @classmethod
     def require(cls) -> None:
