@@ -1,1 +1,287 @@
-"""placeholder"""
+"""CVXPY modelling layer over any installed LP/MIP solver.
+
+The model is one vectorised expression: ``x = Variable(K, boolean=True)`` (or
+``bounds=[0, 1]`` for the LP relaxation), ``A @ x == 1`` with the scipy CSR matrix,
+``minimize c @ x``.  Compilation (``get_problem_data``) and the solver call
+(``solve_via_data``) are run separately so that build and solve times are honest:
+``build_time`` covers assocopt's CSR model, the CVXPY expression and CVXPY's
+canonicalisation; ``solve_time`` the solver call and unpacking its result.
+
+Extra options:
+
+``cvxpy_solver``    CVXPY solver name.  Default for the ILP: the first installed of
+                    HIGHS, SCIP, GLPK_MI, CBC, SCIPY, GUROBI, CPLEX, XPRESS, MOSEK; for
+                    the LP: the first of HIGHS, CLARABEL, SCIPY, GLOP, GUROBI, CPLEX,
+                    MOSEK, XPRESS, PDLP, SCS.  Recorded in ``info["cvxpy_solver"]``.
+``solver_options``  dict of solver keyword options passed to CVXPY, merged over the
+                    limits assocopt sets (nested dicts such as ``scipy_options`` or
+                    ``scip_params`` are merged key by key).
+
+``time_limit``, ``mip_gap`` and ``threads`` are translated for HIGHS, SCIPY, SCIP,
+GUROBI, CPLEX and MOSEK (time limit also CLARABEL, GLOP, PDLP, SCS); for other
+solvers they are not passed, which ``info["limits_passed"]`` records.  The gap is
+always passed to the solvers that take it (HiGHS, Gurobi, CPLEX and MOSEK default
+to 1e-4, not 0).  A reached gap is known for HIGHS and SCIPY (they report a bound);
+with another solver and ``mip_gap > 0`` a solution is FEASIBLE, never OPTIMAL.
+"""
+
+from __future__ import annotations
+
+import time
+import warnings
+from typing import Any
+
+import numpy as np
+
+from ..errors import InvalidProblemError, SolverCapabilityError, SolverNotInstalledError
+from ..formulation import build_model
+from ..problem import AssignmentProblem
+from ..solution import Status, relative_gap
+from .base import Backend, RawResult, SolveOptions, register
+
+__all__ = ["CvxpyBackend"]
+
+_MIP_ORDER = ("HIGHS", "SCIP", "GLPK_MI", "CBC", "SCIPY", "GUROBI", "CPLEX", "XPRESS", "MOSEK")
+_LP_ORDER = ("HIGHS", "CLARABEL", "SCIPY", "GLOP", "GUROBI", "CPLEX", "MOSEK", "XPRESS",
+             "PDLP", "SCS")
+
+# CVXPY status -> assocopt status.  OPTIMAL_INACCURATE is what several interfaces
+# return when a limit stopped the solver with a solution (SCIP, CBC, SCIPY), or for
+# reduced accuracy (interior point): refined in ``_status``.  Variables are bounded,
+# so "unbounded" can only come from numerical failure.
+_STATUS_TABLE: dict[str, Status] = {
+    "optimal": Status.OPTIMAL,
+    "optimal_inaccurate": Status.FEASIBLE,
+    "infeasible": Status.INFEASIBLE,
+    "infeasible_inaccurate": Status.INFEASIBLE,
+    "infeasible_or_unbounded": Status.INFEASIBLE,
+    "unbounded": Status.ERROR,
+    "unbounded_inaccurate": Status.ERROR,
+    "user_limit": Status.TIME_LIMIT,
+    "solver_error": Status.ERROR,
+}
+#: Solvers whose OPTIMAL_INACCURATE always means "stopped by a time/iteration limit".
+_INACCURATE_IS_LIMIT = ("SCIPY",)
+#: CVXPY 1.9 interfaces that fail on any variable bounds (even ``nonneg``): the LP
+#: uses ``0 <= x <= 1`` constraint rows instead.
+_NO_VARIABLE_BOUNDS = ("PDLP",)
+#: Reached relative gaps up to this count as zero, as in the HiGHS back end.
+_GAP_ZERO = 1e-9
+
+
+def _limit_options(solver: str, options: SolveOptions,
+                   is_mip: bool) -> tuple[dict[str, Any], list[str]]:
+    """CVXPY keyword options for the time limit, gap and threads of ``solver``."""
+    t, gap, n = options.time_limit, float(options.mip_gap), options.threads
+    opts: dict[str, Any] = {}
+    nested: dict[str, Any] = {}
+
+    def put(limit: str, target: dict[str, Any], key: str, value: Any) -> None:
+        if value is not None:
+            target[key] = value
+            passed.append(limit)
+
+    passed: list[str] = []
+    gap_ = gap if is_mip else None
+    if solver == "HIGHS":
+        put("time_limit", opts, "time_limit", None if t is None else float(t))
+        put("mip_gap", opts, "mip_rel_gap", gap_)
+        put("threads", opts, "threads", n)
+    elif solver == "SCIPY":
+        opts["scipy_options"] = nested
+        put("time_limit", nested, "time_limit", None if t is None else float(t))
+        put("mip_gap", nested, "mip_rel_gap", gap_)
+    elif solver == "SCIP":
+        opts["scip_params"] = nested
+        put("time_limit", nested, "limits/time", None if t is None else float(t))
+        put("mip_gap", nested, "limits/gap", gap_)
+    elif solver == "GUROBI":
+        put("time_limit", opts, "TimeLimit", t)
+        put("mip_gap", opts, "MIPGap", gap_)
+        put("threads", opts, "Threads", n)
+    elif solver == "CPLEX":
+        opts["cplex_params"] = nested
+        put("time_limit", nested, "timelimit", t)
+        put("mip_gap", nested, "mip.tolerances.mipgap", gap_)
+        put("threads", nested, "threads", n)
+    elif solver == "MOSEK":
+        opts["mosek_params"] = nested
+        put("time_limit", nested, "MSK_DPAR_OPTIMIZER_MAX_TIME", t)
+        put("mip_gap", nested, "MSK_DPAR_MIO_TOL_REL_GAP", gap_)
+        put("threads", nested, "MSK_IPAR_NUM_THREADS", n)
+    elif solver == "CLARABEL":
+        put("time_limit", opts, "time_limit", t)
+    elif solver in ("GLOP", "PDLP"):
+        put("time_limit", opts, "time_limit_sec", t)
+    elif solver == "SCS":
+        put("time_limit", opts, "time_limit_secs", t)
+    return opts, passed
+
+
+def _merge(base: dict[str, Any], user: dict[str, Any]) -> dict[str, Any]:
+    """``base`` updated by ``user``, merging one level of nested dicts."""
+    out = dict(base)
+    for key, value in user.items():
+        if isinstance(value, dict) and isinstance(out.get(key), dict):
+            out[key] = {**out[key], **value}
+        else:
+            out[key] = value
+    return out
+
+
+def _choose_solver(requested: Any, is_mip: bool, installed: list[str]) -> str:
+    """The CVXPY solver to use: the requested one (checked) or the first installed."""
+    try:
+        from cvxpy.reductions.solvers.defines import MI_SOLVERS
+    except ImportError:                    # layout changed: let CVXPY itself refuse
+        MI_SOLVERS = installed
+    order = _MIP_ORDER if is_mip else _LP_ORDER
+    if requested is None:
+        for name in order:
+            if name in installed:
+                return name
+        raise SolverNotInstalledError(
+            f"cvxpy has no {'MIP' if is_mip else 'LP'} solver installed; install one of "
+            f"{', '.join(order)} (e.g. pip install highspy)")
+    if not isinstance(requested, str):
+        raise InvalidProblemError(f"cvxpy_solver must be a string, got {requested!r}")
+    name = requested.upper()
+    if name not in installed:
+        raise SolverNotInstalledError(
+            f"cvxpy solver {requested!r} is not installed; installed: {', '.join(installed)}")
+    if is_mip and name not in MI_SOLVERS:
+        raise SolverCapabilityError(
+            f"cvxpy solver {name} cannot solve integer programs; use relax='lp' or one of "
+            f"{', '.join(n for n in _MIP_ORDER if n in installed)}")
+    return name
+
+
+@register
+class CvxpyBackend(Backend):
+    """CVXPY, one vectorised constraint ``A @ x == 1``, solved by any installed solver."""
+
+    name = "cvxpy"
+    module = "cvxpy"
+    distribution = "cvxpy"
+    description = "CVXPY model (boolean x, A @ x == 1) on HiGHS or another installed solver"
+    lp = True
+    supports_time_limit = True
+
+    def solve(self, problem: AssignmentProblem, options: SolveOptions) -> RawResult:
+        import cvxpy as cp
+
+        is_mip = options.relax is None
+        extra = dict(options.extra)
+        requested = extra.pop("cvxpy_solver", None)
+        user_opts = extra.pop("solver_options", {})
+        if extra:
+            raise InvalidProblemError(
+                f"unknown cvxpy option {sorted(extra)[0]!r}; valid: 'cvxpy_solver', "
+                "'solver_options'")
+        if not isinstance(user_opts, dict):
+            raise InvalidProblemError("cvxpy option solver_options must be a dict")
+        solver = _choose_solver(requested, is_mip, cp.installed_solvers())
+        limit_opts, passed = _limit_options(solver, options, is_mip)
+        solver_opts = _merge(limit_opts, user_opts)
+        info: dict[str, Any] = {"cvxpy_solver": solver, "limits_passed": passed}
+
+        t0 = time.perf_counter()
+        model = build_model(problem, options.relax)
+        K = model.shape[1]
+        constraints: list[Any] = []
+        if is_mip:
+            x = cp.Variable(K, boolean=True)
+        elif solver in _NO_VARIABLE_BOUNDS:
+            x = cp.Variable(K)
+            constraints += [x >= 0, x <= 1]
+        else:                  # column bounds, not K extra rows, where the solver takes them
+            x = cp.Variable(K, bounds=[0.0, 1.0])
+        constraints.append(model.A @ x == 1)
+        prob = cp.Problem(cp.Minimize(model.c @ x), constraints)
+        t1: float | None = None
+        try:
+            with warnings.catch_warnings():
+                if not options.verbose:
+                    warnings.simplefilter("ignore")
+                data, chain, inverse = prob.get_problem_data(
+                    solver=solver, verbose=bool(options.verbose), solver_opts=solver_opts)
+                t1 = time.perf_counter()
+                raw = chain.solve_via_data(prob, data, warm_start=False,
+                                           verbose=bool(options.verbose),
+                                           solver_opts=solver_opts)
+                prob.unpack_results(raw, chain, inverse)
+        except cp.error.SolverError as exc:      # includes CVXPY's "solver_error" status
+            t2 = time.perf_counter()
+            t1 = t2 if t1 is None else t1
+            # SCIPY (and others) report "no solution" as an error when the limit hits.
+            if options.time_limit is not None and t2 - t1 >= options.time_limit:
+                return RawResult(Status.TIME_LIMIT, info=info, build_time=t1 - t0,
+                                 solve_time=t2 - t1,
+                                 message=f"cvxpy/{solver}: no solution within the time "
+                                         f"limit ({exc})")
+            return RawResult(Status.ERROR, message=f"cvxpy/{solver}: {exc}", info=info,
+                             build_time=t1 - t0, solve_time=t2 - t1)
+        except (ValueError, TypeError) as exc:
+            if user_opts:                         # most likely a rejected solver option
+                raise InvalidProblemError(
+                    f"cvxpy/{solver} rejected solver_options {user_opts!r}: {exc}") from exc
+            raise
+        t2 = time.perf_counter()
+
+        native = str(prob.status)
+        info["cvxpy_status"] = native
+        result = RawResult(Status.ERROR, info=info, build_time=t1 - t0, solve_time=t2 - t1)
+        values = x.value
+        objective = bound = None
+        if values is not None and native in ("optimal", "optimal_inaccurate", "user_limit"):
+            values = np.asarray(values, dtype=np.float64).ravel()
+            objective = float(prob.value)
+            if is_mip:
+                selected = np.flatnonzero(values > 0.5)
+                # A limit-stopped solver may hand back a non-incumbent point: keep
+                # only a selection that is a feasible assignment.
+                if native == "optimal" or problem.violations(selected) is None:
+                    result.selected = selected
+                bound = self._bound(prob)
+                result.bound = bound
+            else:
+                result.x = values
+                result.objective = objective
+        result.status, note = self._status(native, solver, objective, bound, options,
+                                           is_mip, t2 - t1)
+        result.message = f"cvxpy/{solver}: {native}" + (f"; {note}" if note else "")
+        return result
+
+    @staticmethod
+    def _bound(prob: Any) -> float | None:
+        """The MIP dual bound that HIGHS and SCIPY report through ``extra_stats``."""
+        stats = getattr(prob.solver_stats, "extra_stats", None)
+        if stats is None:
+            return None
+        value = stats.get("mip_dual_bound") if isinstance(stats, dict) else \
+            getattr(stats, "mip_dual_bound", None)
+        try:
+            value = float(value)
+        except (TypeError, ValueError):
+            return None
+        return value if np.isfinite(value) else None
+
+    @staticmethod
+    def _status(native: str, solver: str, objective: float | None, bound: float | None,
+                options: SolveOptions, is_mip: bool, elapsed: float) -> tuple[Status, str]:
+        """Map ``native`` through ``_STATUS_TABLE`` and refine it."""
+        status = _STATUS_TABLE.get(native, Status.ERROR)
+        limit_elapsed = options.time_limit is not None and elapsed >= options.time_limit
+        if native == "optimal_inaccurate" and (solver in _INACCURATE_IS_LIMIT or limit_elapsed):
+            return Status.TIME_LIMIT, "stopped by a limit"
+        if native == "infeasible_inaccurate":
+            return status, "infeasibility reported with reduced accuracy"
+        if status is Status.OPTIMAL and is_mip and options.mip_gap > 0:
+            gap = relative_gap(objective, bound)
+            if gap is None:
+                return Status.FEASIBLE, "mip_gap > 0 and the solver reports no bound"
+            if gap > _GAP_ZERO:
+                return Status.FEASIBLE, f"stopped at relative gap {gap:.3g}"
+        if native not in _STATUS_TABLE:
+            return Status.ERROR, f"unexpected CVXPY status {native!r}"
+        return status, ""

@@ -1,1 +1,215 @@
-"""placeholder"""
+"""Google OR-Tools CP-SAT on the exact-cover ILP (integer costs required).
+
+CP-SAT only takes integer objective coefficients, so float costs are multiplied by
+a power of ten and rounded to int64.  When that rounding is exact (integer costs,
+or decimals such as 0.25 with scale 100) CP-SAT's optimum is the true optimum; when
+it is not, CP-SAT's optimum is only near-optimal and is reported as ``FEASIBLE``
+with a lower bound that accounts for the rounding (see :func:`_scaled_costs`).
+
+The CpModelProto is filled in bulk: all K Boolean variables in one
+``variables.extend`` of a shared template, the objective with two numpy
+``extend`` calls, and one ``exactly_one`` constraint per coverage row.
+
+Extra options (``assocopt.solve(..., solver="ortools-cpsat", **extra)``):
+
+``scale``  positive number, or ``"auto"`` (default): 1 for integer costs, else
+           the largest ``10**k`` (k <= 9) keeping ``max|c| * scale * rows`` below
+           1e15 (exact in float64) and ``sum|c| * scale`` below 2**62 (CP-SAT's
+           int64 overflow check).
+``seed``   CP-SAT ``random_seed`` (default 0).  Runs are reproducible with
+           ``threads=1``; with several workers CP-SAT's portfolio is not
+           deterministic in general (CP-SAT's default uses every core).
+any other key is set on CP-SAT's ``SatParameters`` by name (``max_number_of_conflicts=...``,
+``interleave_search=True``...); an unknown name is an error.
+"""
+
+from __future__ import annotations
+
+import math
+import time
+from typing import Any
+
+import numpy as np
+
+from ..errors import InvalidProblemError
+from ..formulation import build_model
+from ..problem import AssignmentProblem
+from ..solution import Status, relative_gap
+from .base import Backend, RawResult, SolveOptions, register
+
+__all__ = ["CpSatBackend"]
+
+#: Scaled objective magnitudes stay below this (integers exact in float64).
+_MAX_SCALED_TOTAL = 1e15
+#: Sum of |scaled coefficient| must stay below this (CP-SAT rejects possible int64 overflow).
+_MAX_SCALED_SUM = 2.0 ** 62
+#: Largest decimal exponent "auto" scaling uses.
+_MAX_EXPONENT = 9
+
+# Native CP-SAT status -> assocopt status, before the rounding and gap refinements
+# made in ``CpSatBackend._status``.  CP-SAT's FEASIBLE means "stopped before proving
+# optimality" (our model always has an objective), i.e. a limit was hit.
+_STATUS_TABLE: dict[str, Status] = {
+    "OPTIMAL": Status.OPTIMAL,
+    "FEASIBLE": Status.TIME_LIMIT,
+    "INFEASIBLE": Status.INFEASIBLE,
+    "UNKNOWN": Status.TIME_LIMIT,       # a limit stopped it before any solution
+    "MODEL_INVALID": Status.ERROR,
+}
+
+
+def _auto_scale(costs: np.ndarray, n_rows: int) -> float:
+    """The ``"auto"`` scale: 1 for (small enough) integer costs, else a power of ten."""
+    amax = float(np.abs(costs).max(initial=0.0))
+    asum = float(np.abs(costs).sum())
+    if amax == 0.0:
+        return 1.0
+
+    def fits(s: float) -> bool:
+        return amax * s * n_rows <= _MAX_SCALED_TOTAL and asum * s <= _MAX_SCALED_SUM
+
+    if np.all(costs == np.round(costs)) and fits(1.0):
+        return 1.0
+    k = min(_MAX_EXPONENT, math.floor(math.log10(_MAX_SCALED_TOTAL / (amax * n_rows))))
+    while not fits(10.0 ** k):          # the sum condition, or log10 rounding
+        k -= 1
+    return 10.0 ** k
+
+
+def _scaled_costs(costs: np.ndarray, n_rows: int,
+                  scale_opt: Any) -> tuple[float, np.ndarray, float]:
+    """``(scale, int64 costs, max rounding error)`` for the ``scale`` option.
+
+    The rounding error ``e = max_k |round(c_k * scale) / scale - c_k|`` turns CP-SAT's
+    bound ``B`` on the scaled problem into a valid bound ``B / scale - rows * e`` on
+    the original one: a feasible solution picks at most ``rows`` candidates (each
+    covers at least one row, and rows are covered once).
+    """
+    if isinstance(scale_opt, str) and scale_opt == "auto":
+        scale = _auto_scale(costs, n_rows)
+    elif (isinstance(scale_opt, (int, float, np.integer, np.floating))
+          and not isinstance(scale_opt, bool) and math.isfinite(scale_opt) and scale_opt > 0):
+        scale = float(scale_opt)
+    else:
+        raise InvalidProblemError(
+            f"ortools-cpsat option scale must be 'auto' or a positive number, got {scale_opt!r}")
+    scaled = costs * scale
+    if float(np.abs(scaled).sum()) > _MAX_SCALED_SUM:
+        raise InvalidProblemError(
+            f"ortools-cpsat scale={scale:g} makes the integer objective overflow int64 "
+            f"(sum |c| * scale must stay below 2**62); use a smaller scale")
+    rounded = np.rint(scaled).astype(np.int64)
+    max_err = float(np.abs(rounded / scale - costs).max(initial=0.0))
+    return scale, rounded, max_err
+
+
+def _apply_parameters(params: Any, options: SolveOptions, extra: dict[str, Any]) -> None:
+    """Common options, then pass-through ``SatParameters`` fields from ``extra``."""
+    seed = extra.pop("seed", 0)
+    if isinstance(seed, bool) or not isinstance(seed, (int, np.integer)):
+        raise InvalidProblemError(f"ortools-cpsat option seed must be an integer, got {seed!r}")
+    params.log_search_progress = bool(options.verbose)
+    params.random_seed = int(seed)
+    if options.time_limit is not None:
+        params.max_time_in_seconds = float(options.time_limit)
+    params.relative_gap_limit = float(options.mip_gap)
+    if options.threads is not None:
+        params.num_workers = int(options.threads)
+    for key, value in extra.items():
+        if not hasattr(params, key):
+            raise InvalidProblemError(
+                f"unknown ortools-cpsat option {key!r}: not 'scale', 'seed' or a "
+                "CP-SAT SatParameters field")
+        try:
+            setattr(params, key, value)
+        except (TypeError, ValueError) as exc:
+            raise InvalidProblemError(
+                f"ortools-cpsat option {key}={value!r} was rejected: {exc}") from exc
+
+
+@register
+class CpSatBackend(Backend):
+    """OR-Tools CP-SAT (clause learning + LP + portfolio search) on scaled integer costs."""
+
+    name = "ortools-cpsat"
+    module = "ortools"
+    distribution = "ortools"
+    description = "OR-Tools CP-SAT on the exact-cover ILP, costs scaled to integers"
+    lp = False
+    supports_time_limit = True
+    exact_float_costs = False   # proves optimality of the integer-scaled costs only
+
+    def solve(self, problem: AssignmentProblem, options: SolveOptions) -> RawResult:
+        from ortools.sat.python import cp_model
+
+        extra = dict(options.extra)
+        scale_opt = extra.pop("scale", "auto")
+        t0 = time.perf_counter()
+        model = build_model(problem, options.relax)
+        A, K, n_rows = model.A, model.shape[1], model.shape[0]
+        scale, icosts, max_err = _scaled_costs(model.c, n_rows, scale_opt)
+
+        cp = cp_model.CpModel()
+        proto = cp.proto
+        # Variables: one template proto copied K times.  Measured for K = 27 000 /
+        # 1 000 000: extend 7 ms / 0.65 s; merge_text_format 17 ms / 1.0 s;
+        # new_bool_var loop 72 ms / 4.2 s (new_bool_var_series is that loop in pandas).
+        template = cp.new_bool_var("")
+        proto.variables.extend([proto.variables[template.index]] * (K - 1))
+        # Objective straight into the proto: the equivalent of LinearExpr.weighted_sum
+        # without K Python variable objects (3 ms vs 60 ms for K = 27 000).
+        proto.objective.vars.extend(np.arange(K, dtype=np.int64))
+        proto.objective.coeffs.extend(icosts)
+        indptr, indices = A.indptr, A.indices.astype(np.int64)
+        for r in range(n_rows):           # one exactly-one constraint per coverage row
+            proto.constraints.add().exactly_one.literals.extend(indices[indptr[r]:indptr[r + 1]])
+
+        solver = cp_model.CpSolver()
+        _apply_parameters(solver.parameters, options, extra)
+        t1 = time.perf_counter()
+        native = solver.solve(cp)
+        t2 = time.perf_counter()
+
+        response = solver.response_proto
+        name = native.name
+        info: dict[str, Any] = {
+            "cpsat_status": name, "cpsat_scale": scale, "max_rounding_error": max_err,
+            "num_workers": int(solver.parameters.num_workers),   # 0: CP-SAT's default
+            "random_seed": int(solver.parameters.random_seed),
+            "num_conflicts": int(response.num_conflicts),
+            "num_branches": int(response.num_branches),
+            "cpsat_wall_time": float(response.wall_time),
+        }
+        result = RawResult(status=Status.ERROR, info=info, build_time=t1 - t0,
+                           solve_time=t2 - t1)
+        has_solution = name in ("OPTIMAL", "FEASIBLE")
+        if has_solution:
+            values = np.fromiter(response.solution, dtype=np.int64, count=K)
+            result.selected = np.flatnonzero(values > 0)
+            info["cpsat_objective"] = float(response.objective_value)
+            info["cpsat_bound"] = float(response.best_objective_bound)
+            # Bound on the scaled problem -> valid bound on the original costs.
+            result.bound = (float(response.best_objective_bound) / scale
+                            - n_rows * max_err)
+        result.status, result.message = self._status(name, response, max_err, options, cp)
+        return result
+
+    @staticmethod
+    def _status(name: str, response: Any, max_err: float, options: SolveOptions,
+                cp: Any) -> tuple[Status, str]:
+        """Map CP-SAT's status through ``_STATUS_TABLE``, then refine OPTIMAL."""
+        status = _STATUS_TABLE.get(name, Status.ERROR)
+        message = f"CP-SAT: {name}"
+        if name == "MODEL_INVALID":
+            return status, f"CP-SAT: model invalid: {cp.validate()}"
+        if status is not Status.OPTIMAL:
+            return status, message
+        gap = relative_gap(float(response.objective_value), float(response.best_objective_bound))
+        if max_err > 0.0:
+            return Status.FEASIBLE, (
+                f"CP-SAT: optimal for costs rounded to 1/scale (max rounding error "
+                f"{max_err:.3g}); only near-optimal for the original costs, bound "
+                "corrected for the rounding")
+        if options.mip_gap > 0 and gap is not None and gap > 0:
+            return Status.FEASIBLE, f"CP-SAT: stopped at relative gap {gap:.3g}"
+        return Status.OPTIMAL, message
