@@ -6,21 +6,32 @@
 >>> p = random_problem(np.random.default_rng(0), "sd", sizes=(3, 3, 2))
 >>> assert_optimal(p, solve(p, "highs"))
 
-``problems()`` is a hypothesis strategy (hypothesis is imported only when it is
-called, so this module works without it).
+``problems()`` and ``generated_problems()`` are hypothesis strategies (hypothesis is
+imported only when they are called, so this module works without it);
+``stored_instances()`` lists the project's instances with proven optima, for
+``pytest.mark.parametrize``:
+
+>>> from assocopt.io import read_instance
+>>> from assocopt.testing import stored_instances
+>>> for path in stored_instances():
+...     p = read_instance(path)
+...     assert_optimal(p, solve(p, "highs"))
 """
 
 from __future__ import annotations
 
 import math
-from typing import Any
+import os
+from pathlib import Path
+from typing import Any, Sequence
 
 import numpy as np
 
 from .problem import AssignmentProblem
 from .solution import Solution, Status
 
-__all__ = ["KINDS", "random_problem", "problems", "assert_optimal", "assert_feasible",
+__all__ = ["KINDS", "random_problem", "problems", "generated_problems", "assert_optimal",
+           "assert_feasible", "assert_valid_bound", "reference_optimum", "stored_instances",
            "BRUTE_FORCE_MAX_CANDIDATES"]
 
 #: Problem families produced by :func:`random_problem`.
@@ -105,6 +116,15 @@ def assert_feasible(problem: AssignmentProblem, solution: Solution) -> None:
         f"objective {solution.objective} != sum of chosen costs {total}")
 
 
+def reference_optimum(problem: AssignmentProblem) -> tuple[float, str]:
+    """The optimum to test against, and where it comes from.
+
+    The recorded optimum if the problem carries one, brute force on problems of at
+    most :data:`BRUTE_FORCE_MAX_CANDIDATES` candidates, HiGHS otherwise.
+    """
+    return _reference_optimum(problem)
+
+
 def _reference_optimum(problem: AssignmentProblem) -> tuple[float, str]:
     from .api import solve
     if problem.optimum is not None:
@@ -119,19 +139,80 @@ def _reference_optimum(problem: AssignmentProblem) -> tuple[float, str]:
 
 
 def assert_optimal(problem: AssignmentProblem, solution: Solution, *,
-                   rel: float = 1e-9, abs_tol: float = 1e-9) -> None:
+                   rel: float = 1e-9, abs_tol: float = 1e-9,
+                   reference: float | None = None) -> None:
     """Assert ``solution`` is feasible and optimal for ``problem``.
 
-    The reference is the recorded optimum if the problem carries one, brute force on
-    small problems, HiGHS otherwise.  The failure message names the solver, its
-    status and message.
+    The reference is ``reference`` when given, else the recorded optimum if the
+    problem carries one, brute force on small problems, HiGHS otherwise.  The
+    failure message names the solver, its status and message.
     """
     assert solution.status is Status.OPTIMAL, (
         f"{solution.solver}: status {solution.status}, message {solution.message!r}")
     assert_feasible(problem, solution)
-    ref, how = _reference_optimum(problem)
+    ref, how = ((float(reference), "the given reference") if reference is not None
+                else _reference_optimum(problem))
     assert math.isclose(solution.objective, ref, rel_tol=rel, abs_tol=abs_tol), (
         f"{solution.solver}: objective {solution.objective!r} != {how} {ref!r} "
         f"({solution.message})")
     if solution.bound is not None:
         assert solution.bound <= solution.objective + abs_tol + rel * abs(ref)
+
+
+def assert_valid_bound(problem: AssignmentProblem, solution: Solution, *,
+                       rel: float = 1e-9, abs_tol: float = 1e-9) -> None:
+    """Assert the lower bound of ``solution`` does not exceed the optimum.
+
+    The bound is ``solution.bound``, or for an LP relaxation its objective.  Use it
+    for relaxations and heuristics whose answers need not be optimal.
+    """
+    bound = solution.bound
+    if bound is None and solution.relaxation == "lp":
+        bound = solution.objective
+    assert bound is not None, (
+        f"{solution.solver}: no bound reported (status {solution.status}, "
+        f"message {solution.message!r})")
+    ref, how = _reference_optimum(problem)
+    assert bound <= ref + abs_tol + rel * abs(ref), (
+        f"{solution.solver}: bound {bound!r} exceeds the {how} {ref!r} ({solution.message})")
+
+
+def stored_instances(directory: str | os.PathLike[str] | None = None) -> list[Path]:
+    """The instance files (``*.json``) of ``directory``, sorted.
+
+    Default: ``./instances`` when it exists, else the ``instances/`` folder of the
+    assocopt source checkout (empty list for an installed package without it).
+    """
+    from .generate import default_instances_dir
+
+    folder = Path(directory) if directory is not None else default_instances_dir()
+    if not folder.is_dir():
+        return []
+    return sorted(folder.glob("*.json"))
+
+
+def generated_problems(kinds: Sequence[str] = ("dense", "sparse", "planted"), *,
+                       max_axes: int = 4, max_size: int = 4) -> Any:
+    """Hypothesis strategy of instances from :func:`assocopt.generate.generate`.
+
+    Draws a generator, 2..``max_axes`` axes of size 1..``max_size`` and a seed.
+    ``"planted"`` problems carry their optimum (known by construction), so
+    :func:`assert_optimal` checks against it without a reference solve.
+    """
+    from hypothesis import strategies as st
+
+    from .generate import GENERATORS, generate
+
+    bad = [k for k in kinds if k not in GENERATORS]
+    if bad or not kinds:
+        raise ValueError(f"kinds must be among {GENERATORS}, got {list(kinds)}")
+
+    @st.composite
+    def _draw(draw: Any) -> AssignmentProblem:
+        kind = draw(st.sampled_from(list(kinds)))
+        n_axes = draw(st.integers(2, max_axes))
+        sizes = tuple(draw(st.lists(st.integers(1, max_size), min_size=n_axes,
+                                    max_size=n_axes)))
+        seed = draw(st.integers(0, 2**32 - 1))
+        return generate(kind, seed=seed, sizes=sizes, verify=False)
+    return _draw()
