@@ -193,9 +193,13 @@ def test_bad_options(kw, match):
         solve(AssignmentProblem.dense(np.ones((2, 2))), "highs", **kw)
 
 
-def test_auto_picks_fast_path_in_2d_and_highs_otherwise():
+def test_auto_picks_fast_path_in_2d_and_an_exact_method_otherwise():
     assert solve(AssignmentProblem.dense(np.ones((3, 3))), "auto").solver == "scipy-lsa"
-    assert solve(AssignmentProblem.dense(np.ones((2, 2, 2))), "auto").solver == "highs"
+    p = AssignmentProblem.dense(np.random.default_rng(0).random((4, 4, 4)))
+    sol = solve(p, "auto")
+    assert registered()[sol.solver].exact
+    assert_optimal(p, sol)
+    assert solve(p, "auto", relax="lp").solver == "highs"
 
 
 def test_solution_reports_times_and_version():
