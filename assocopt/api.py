@@ -18,9 +18,13 @@ __all__ = ["solve", "choose_solver"]
 
 
 def choose_solver(problem: AssignmentProblem, relax: str | None = None) -> str:
-    """The back end ``solver="auto"`` picks: the 2-D fast path or HiGHS."""
+    """The back end ``solver="auto"`` picks: the 2-D fast path, the Lagrangian exact
+    method for S-D (N >= 3; measured fastest from n = 3 upwards, see
+    docs/benchmarks-sd.md), or HiGHS for LP relaxations."""
     if relax is None and problem.ndim == 2:
         return "scipy-lsa"
+    if relax is None:
+        return "lagrangian-exact"
     return "highs"
 
 
