@@ -332,6 +332,12 @@ def test_lapx_equals_scipy():
         assert C[r2, c2].sum() == pytest.approx(C[r1, c1].sum(), rel=1e-12)
 
 
+@pytest.mark.skipif(lapx_available(), reason="lapx installed")
+def test_lap_option_lapx_without_the_package_names_it():
+    with pytest.raises(SolverNotInstalledError, match="lapx"):
+        solve(_rand3(3), "lagrangian", lap="lapx")
+
+
 def test_lapjv_backend_names_the_missing_package(monkeypatch):
     from assocopt.solvers.lap import LapjvBackend
     monkeypatch.setattr(LapjvBackend, "is_available", classmethod(lambda cls: False))

@@ -88,12 +88,12 @@ from typing import Any
 import numpy as np
 import scipy.sparse as sp
 
-from ..errors import InvalidProblemError
+from ..errors import InvalidProblemError, SolverNotInstalledError
 from ..problem import AssignmentProblem
 from ..solution import Status
 from .base import Backend, RawResult, SolveOptions, register
 from .lap import (LAP_METHODS, Assignment2D, LapInfeasibleError, assign_with_misses,
-                  assignment_duals, linear_assignment)
+                  assignment_duals, lapx_available, linear_assignment)
 
 __all__ = ["LagrangianBackend", "LagrangianExactBackend", "OPT_TOL", "dominated",
            "lagrangian_bound"]
@@ -808,6 +808,9 @@ def _parse(extra: dict[str, Any], exact: bool, name: str) -> dict[str, Any]:
         raise InvalidProblemError(f"option init must be 'share' or 'zero', got {p['init']!r}")
     if p["lap"] not in LAP_METHODS:
         raise InvalidProblemError(f"option lap must be one of {LAP_METHODS}, got {p['lap']!r}")
+    if p["lap"] == "lapx" and not lapx_available():
+        raise SolverNotInstalledError("option lap='lapx' needs the Python package 'lapx': "
+                                      "pip install lapx")
     if p["gate"] is not None:
         g = p["gate"]
         if isinstance(g, bool) or not isinstance(g, (int, float, np.floating)) or math.isnan(g):

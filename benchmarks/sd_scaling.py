@@ -1,0 +1,636 @@
+"""S-D assignment at scale: Lagrangian relaxation against MILP and CP solvers, one run.
+
+    python benchmarks/sd_scaling.py            # full run, writes docs/benchmarks-sd.md
+    python benchmarks/sd_scaling.py --quick    # smoke run (small instances only)
+
+Families (every instance is solved by every method in this one process):
+
+* the 120 axial 3-AP instances of ../shared/ap_instances (Grundel n = 5..50,
+  Balas-Saltzman n = 4..26), with proven optima;
+* 3-AP with costs ``d_ij + d_ik + d_jk`` (random integer d in 1..100,
+  Crama-Spieksma-style): LP relaxation not integral;
+* random S-D tracking instances with dummies: N = 3..6 sensors, 10..50 targets,
+  P_D = 0.8, Poisson false alarms, gated tuples, negative log-likelihood-ratio costs;
+* paper 002's scenario (``assocopt.scenarios.lu2013``) when that package is present:
+  the small problems a Monte Carlo study solves by the thousand.
+
+Methods: ``lagrangian`` (bound + heuristic), ``lagrangian-exact``, ``highs`` (HiGHS
+through highspy), ``scipy`` (scipy.optimize.milp), ``ortools-cpsat``.  Reported: time
+to a proven optimum (per-solve time limit), the gap after a fixed time, the plain
+Lagrangian's gap after 100 iterations, the in-process latency of ``solver="auto"`` on
+small problems, and the 2-D LAP engines at n = 2000.  Peers run on a subset of the
+large 3-AP instances (first instance of each size above n = 10) to keep the whole run
+under 15 minutes on 2 cores; ratios are taken on the instances both sides solved.
+"""
+
+from __future__ import annotations
+
+import argparse
+import math
+import os
+import platform
+import statistics
+import sys
+import tempfile
+import time
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+
+ROOT = Path(__file__).resolve().parents[1]
+sys.path.insert(0, str(ROOT))
+
+from assocopt import AssignmentProblem, Status, solve  # noqa: E402
+from assocopt.solvers import registered  # noqa: E402
+
+PEERS = ("highs", "scipy", "ortools-cpsat")
+EXACT = ("lagrangian-exact",) + PEERS
+
+
+# ----------------------------------------------------------------------- instances
+@dataclass
+class Instance:
+    family: str
+    name: str
+    size: int                 # n (3-AP) or number of targets
+    problem: AssignmentProblem
+    optimum: float | None = None
+    peers: bool = True        # run the MILP/CP peers on it
+
+
+def ap_instances(ap_dir: Path, quick: bool) -> list[Instance]:
+    if not ap_dir.is_dir():
+        return []
+    sys.path.insert(0, str(ap_dir))
+    from load import known_value, load   # the shared folder's own loader
+    out = []
+    files = sorted((ap_dir / "grundel_ap3").glob("ap3.*.txt"),
+                   key=lambda p: tuple(int(x) for x in p.stem.split(".")[1:]))
+    files += sorted((ap_dir / "balas_saltzman" / "split").glob("balas-n*.txt"),
+                    key=lambda p: (int(p.stem.split("-")[1][1:]), p.stem))
+    for path in files:
+        grundel = path.name.startswith("ap3")
+        n = int(path.stem.split(".")[1]) if grundel else int(path.stem.split("-")[1][1:])
+        inst = int(path.stem.split(".")[2]) if grundel else int(path.stem[-2:])
+        if quick and n > 20:
+            continue
+        C, _ = load(str(path))
+        out.append(Instance("grundel" if grundel else "balas-saltzman", path.stem, n,
+                            AssignmentProblem.dense(C.astype(float), name=path.stem),
+                            float(known_value(str(path))), peers=n <= 10 or inst == 1))
+    return out
+
+
+def crama_spieksma(rng: np.random.Generator, n: int) -> AssignmentProblem:
+    """3-AP with c_ijk = d_ij + d_ik + d_jk, d uniform integers in 1..100."""
+    dij, dik, djk = (rng.integers(1, 101, size=(n, n)).astype(float) for _ in range(3))
+    return AssignmentProblem.dense(dij[:, :, None] + dik[:, None, :] + djk[None, :, :])
+
+
+def tracking(rng: np.random.Generator, N: int, n_targets: int, pd: float = 0.8,
+             clutter: float = 5.0, sigma: float = 0.02, gate_sigmas: float = 4.0
+             ) -> AssignmentProblem:
+    """N sensors see targets in the unit square (P_D, Gaussian noise sigma) plus
+    Poisson(clutter) false alarms; tuples gated on the distance to their centroid;
+    cost = -log likelihood ratio against "all false alarms" (single-measurement
+    tuples cost 0)."""
+    targets = rng.random((n_targets, 2))
+    meas = []
+    for _ in range(N):
+        seen = targets[rng.random(n_targets) < pd]
+        fa = rng.random((rng.poisson(clutter), 2))
+        z = np.concatenate([seen + rng.normal(0, sigma, seen.shape), fa])
+        meas.append(z[rng.permutation(len(z))])
+    sizes = tuple(len(z) for z in meas)
+    gate = gate_sigmas * sigma * math.sqrt(2)
+    parts, psum, pcnt = np.zeros((1, 0), np.int64), np.zeros((1, 2)), np.zeros(1)
+    for s in range(N):
+        Z = meas[s]
+        cen = psum / np.maximum(pcnt, 1)[:, None]
+        d = np.linalg.norm(cen[:, None, :] - Z[None, :, :], axis=2)
+        pi, zi = np.nonzero((pcnt[:, None] == 0) | (d <= gate))
+        parts = np.concatenate([np.concatenate([parts, np.zeros((len(parts), 1), np.int64)], 1),
+                                np.concatenate([parts[pi], (zi + 1)[:, None]], 1)])
+        psum = np.concatenate([psum, psum[pi] + Z[zi]])
+        pcnt = np.concatenate([pcnt, pcnt[pi] + 1])
+    keep = pcnt > 0
+    T, psum, pcnt = parts[keep], psum[keep], pcnt[keep]
+    cen = psum / pcnt[:, None]
+    resid = np.zeros(len(T))
+    for s in range(N):
+        real = T[:, s] > 0
+        resid[real] += ((meas[s][T[real, s] - 1] - cen[real]) ** 2).sum(1) / sigma ** 2
+    cost = 0.5 * resid - pcnt * math.log(pd / (2 * math.pi * sigma ** 2 * clutter)) \
+        - (N - pcnt) * math.log(1 - pd)
+    cost[pcnt < 2] = 0.0
+    return AssignmentProblem.sparse(sizes, T, cost)
+
+
+def lu2013_problems(rng, M: int, pd: float, clutter: float, count: int):
+    try:
+        from assocopt.costs.sd_builder import build_problem
+        from assocopt.scenarios.lu2013 import Lu2013
+    except ImportError:
+        return None
+    sc = Lu2013(n_targets=M, d=0.5, sigma_mrad=5.0, pd=pd, clutter_rate=clutter)
+    return [build_problem(sc.simulate(rng)[0], "pattipati") for _ in range(count)]
+
+
+# ----------------------------------------------------------------------- running
+@dataclass
+class Run:
+    solver: str
+    time: float
+    status: str
+    objective: float | None
+    bound: float | None
+    gap: float | None
+    info: dict = field(default_factory=dict)
+
+    @property
+    def proven(self) -> bool:
+        return self.status == "optimal"
+
+
+def run(problem: AssignmentProblem, solver: str, **kw) -> Run:
+    t0 = time.perf_counter()
+    try:
+        sol = solve(problem, solver, **kw)
+    except Exception as exc:   # a peer failing must not end the benchmark
+        return Run(solver, time.perf_counter() - t0, f"error: {exc}"[:80], None, None, None)
+    dt = time.perf_counter() - t0
+    keep = {k: sol.info.get(k) for k in ("iterations", "stop", "proof") if k in sol.info}
+    return Run(solver, dt, sol.status.value, sol.objective, sol.bound, sol.gap, keep)
+
+
+def available(name: str) -> bool:
+    cls = registered().get(name)
+    return cls is not None and cls.is_available()
+
+
+def warm_up(solvers) -> None:
+    p = AssignmentProblem.dense(np.random.default_rng(0).random((4, 4, 4)))
+    for s in solvers:
+        run(p, s)
+        run(p, s)
+
+
+def agrees(a: float | None, b: float | None) -> bool:
+    return a is not None and b is not None and \
+        abs(a - b) <= 1e-6 * max(1.0, abs(a), abs(b))
+
+
+# ----------------------------------------------------------------------- sections
+def exact_section(instances, solvers, limit, cpsat_limit, log, ref_all=False) -> dict:
+    """Time to proven optimum, every solver on its instances."""
+    rows = {}
+    for inst in instances:
+        res = {}
+        for s in solvers:
+            if s != "lagrangian-exact" and not inst.peers and not (ref_all and s == "scipy"):
+                continue
+            res[s] = run(inst.problem, s,
+                         time_limit=cpsat_limit if s == "ortools-cpsat" else limit)
+        ref = inst.optimum
+        if ref is None:
+            proven = [r.objective for r in res.values() if r.proven]
+            ref = proven[0] if proven else None
+        for r in res.values():
+            r.info["correct"] = (not r.proven) or ref is None or agrees(r.objective, ref)
+        rows[inst.name] = (inst, res)
+        log(f"{inst.family:15s} {inst.name:24s} K={inst.problem.n_candidates:7d} " +
+            " ".join(f"{s}={r.time:7.3f}s{'' if r.proven else '*'}"
+                     f"{'' if r.info['correct'] else '!WRONG'}" for s, r in res.items()))
+    return rows
+
+
+def fixed_time_section(instances, solvers, t_fixed, log) -> dict:
+    out = {}
+    for inst in instances:
+        res = {s: run(inst.problem, s, time_limit=t_fixed) for s in solvers}
+        out[inst.name] = (inst, res)
+        log(f"gap after {t_fixed:g}s on {inst.name}: " +
+            " ".join(f"{s}={_pct(r.gap)}" for s, r in res.items()))
+    return out
+
+
+def plain_section(instances, log) -> list:
+    out = []
+    for inst in instances:
+        r = run(inst.problem, "lagrangian", max_iter=100, gap_tol=0.0)
+        it = r.info.get("iterations") or 1
+        out.append((inst, r, r.time / it))
+        log(f"lagrangian 100 it on {inst.name}: gap {_pct(r.gap)} in {it} it, "
+            f"{1e3 * r.time / it:.2f} ms/it")
+    return out
+
+
+def latency_section(groups, solvers, log) -> list:
+    out = []
+    for label, probs in groups:
+        row = {}
+        for s in solvers:
+            for p in probs[:3]:
+                run(p, s)          # warm caches for this size
+            times, ok = [], 0
+            for p in probs:
+                t0 = time.perf_counter()
+                sol = solve(p, s)
+                times.append(time.perf_counter() - t0)
+                ok += sol.status is Status.OPTIMAL
+            row[s] = (statistics.median(times), max(times), ok, len(probs))
+        out.append((label, probs[0].n_candidates, row))
+        log(f"latency {label}: " + " ".join(
+            f"{s}={1e3 * v[0]:.2f}ms" for s, v in row.items()))
+    return out
+
+
+_LAP_CODE = r"""
+import json, sys, time
+import numpy as np
+from scipy.optimize import linear_sum_assignment
+from assocopt.solvers.lap import assign_with_misses, lapx_available, linear_assignment
+quick = sys.argv[1] == "1"
+rng = np.random.default_rng(0)
+n = 500 if quick else 2000
+def best_of(fs, k=7):
+    # interleaved repeats, minimum of each: robust to load from other processes
+    ts = [[] for _ in fs]
+    for _ in range(k):
+        for t, f in zip(ts, fs):
+            t0 = time.perf_counter(); f(); t.append(time.perf_counter() - t0)
+    return [min(t) for t in ts]
+rows = []
+for kind, C in (("uniform [0,1)", rng.random((n, n))),
+                ("integers 0..999", rng.integers(0, 1000, (n, n)).astype(float))):
+    fs = [lambda: linear_sum_assignment(C), lambda: linear_assignment(C, "scipy")]
+    if lapx_available():
+        fs.append(lambda: linear_assignment(C, "lapx"))
+    t = best_of(fs)
+    rows.append([f"dense n={n}, {kind}", t[0], t[1], t[2] if len(t) > 2 else None])
+m = 2000 if quick else 20000
+r = np.repeat(np.arange(m), 10)
+c = (r + rng.integers(-20, 21, size=len(r))) % m
+key = np.unique(r * m + c)
+r, c = key // m, key % m
+w = rng.random(len(r))
+miss = np.full(m, 0.8)
+t_sp = best_of([lambda: assign_with_misses(m, m, r, c, w, miss, miss, method="sparse")], k=2)[0]
+rows.append([f"gated sparse n={m} ({len(w)} edges) with miss costs, LAPJVsp", None, t_sp, None])
+print(json.dumps(rows))
+"""
+
+
+def lap_section(quick, lapx_path, log) -> list:
+    """2-D LAP engines, in a subprocess so that lapx (a side install given by
+    ``--lapx-path``) never leaks into the S-D measurements above."""
+    import json
+    import subprocess
+    env = dict(os.environ)
+    paths = [str(ROOT)] + ([lapx_path] if lapx_path else [])
+    env["PYTHONPATH"] = os.pathsep.join(paths + [env.get("PYTHONPATH", "")])
+    out = subprocess.run([sys.executable, "-c", _LAP_CODE, "1" if quick else "0"],
+                         env=env, capture_output=True, text=True, check=True)
+    rows = json.loads(out.stdout)
+    for row in rows:
+        log(f"LAP {row[0]}: scipy {row[1]} assocopt(scipy path) {row[2]} lapx {row[3]}")
+    return rows
+
+
+# ----------------------------------------------------------------------- report
+def _pct(g):
+    return "n/a" if g is None else ("inf" if not math.isfinite(g) else f"{100 * g:.3g}%")
+
+
+def _fmt_t(r: Run | None) -> str:
+    if r is None:
+        return "-"
+    mark = "" if r.proven else " (not proven)"
+    if not r.info.get("correct", True):
+        mark += " WRONG"
+    return f"{r.time:.3f}{mark}"
+
+
+def machine_info() -> list[str]:
+    import highspy  # noqa: F401
+    import importlib.metadata as md
+    cpu = platform.processor() or "unknown"
+    try:
+        for line in open("/proc/cpuinfo"):
+            if line.startswith("model name"):
+                cpu = line.split(":", 1)[1].strip()
+                break
+    except OSError:
+        pass
+    vers = []
+    for d in ("numpy", "scipy", "highspy", "ortools", "lapx", "matplotlib"):
+        try:
+            vers.append(f"{d} {md.version(d)}")
+        except md.PackageNotFoundError:
+            vers.append(f"{d} (not installed)")
+    load = os.getloadavg() if hasattr(os, "getloadavg") else ("?",)
+    return [f"- CPU: {cpu}, {os.cpu_count()} logical cores; {platform.platform()}",
+            f"- Python {platform.python_version()}; " + ", ".join(vers),
+            f"- load average at start: {', '.join(f'{v:.2f}' for v in load)}"]
+
+
+def family_table(rows, solvers) -> list[str]:
+    fams: dict = {}
+    for inst, res in rows.values():
+        fams.setdefault((inst.family, inst.size), []).append((inst, res))
+    head = "| family | n | instances | " + " | ".join(
+        f"{s} total s (proven)" for s in solvers) + " |"
+    lines = [head, "|" + "---|" * (3 + len(solvers))]
+    for (fam, n), items in sorted(fams.items()):
+        cells = []
+        for s in solvers:
+            rs = [res[s] for _, res in items if s in res]
+            if not rs:
+                cells.append("-")
+                continue
+            wrong = sum(not r.info.get("correct", True) for r in rs)
+            cells.append(f"{sum(r.time for r in rs):.3f} ({sum(r.proven for r in rs)}/"
+                         f"{len(rs)}){' WRONG ' + str(wrong) if wrong else ''}")
+        lines.append(f"| {fam} | {n} | {len(items)} | " + " | ".join(cells) + " |")
+    return lines
+
+
+def ratio_lines(rows, solvers, base="scipy") -> list[str]:
+    out = []
+    common = [(inst, res) for inst, res in rows.values()
+              if base in res and "lagrangian-exact" in res]
+    if not common:
+        return ["(no instance ran both)"]
+    for s in solvers:
+        if s == base:
+            continue
+        both = [(res[s], res[base]) for _, res in common if s in res]
+        if not both:
+            continue
+        t_s = sum(a.time for a, _ in both)
+        t_b = sum(b.time for _, b in both)
+        ps = sum(a.proven for a, _ in both)
+        pb = sum(b.proven for _, b in both)
+        out.append(f"| {s} | {len(both)} | {t_s:.2f} | {t_b:.2f} | {t_s / t_b:.4f} "
+                   f"(1/{t_b / max(t_s, 1e-9):.1f}) | {ps} | {pb} |")
+    return ["| method | instances | method total s | scipy total s | ratio | method proven "
+            "| scipy proven |", "|---|---|---|---|---|---|---|"] + out
+
+
+def plot(rows, path: Path, solvers) -> bool:
+    try:
+        import matplotlib
+        matplotlib.use("Agg")
+        import matplotlib.pyplot as plt
+    except ImportError:
+        return False
+    fig, axes = plt.subplots(1, 2, figsize=(11, 4.2))
+    for ax, fam in zip(axes, ("grundel", "balas-saltzman")):
+        for s in solvers:
+            pts: dict = {}
+            for inst, res in rows.values():
+                if inst.family == fam and s in res:
+                    pts.setdefault(inst.size, []).append(res[s].time)
+            if pts:
+                xs = sorted(pts)
+                ax.plot(xs, [statistics.median(pts[x]) for x in xs], marker="o", label=s)
+        ax.set_yscale("log")
+        ax.set_xlabel("n (3-AP size)")
+        ax.set_ylabel("time to proven optimum, s (median)")
+        ax.set_title(f"{fam} 3-AP")
+        ax.grid(True, which="both", alpha=0.3)
+    axes[0].legend(fontsize=8)
+    fig.tight_layout()
+    fig.savefig(path, dpi=110)
+    plt.close(fig)
+    return True
+
+
+def targets(rows, ap_rows, other, plain, lat, lapres) -> list[str]:
+    out = []
+    la = [r["lagrangian-exact"] for _, r in ap_rows.values()]
+    if la:
+        common = [r for _, r in ap_rows.values() if "scipy" in r]
+        t_l = sum(r["lagrangian-exact"].time for r in common)
+        t_s = sum(r["scipy"].time for r in common)
+        out.append(f"- 3-AP, all {len(la)} instances proven by `lagrangian-exact`: "
+                   f"{sum(r.proven and r.info.get('correct', True) for r in la)}/{len(la)}; "
+                   f"on the {len(common)} instances scipy also ran, total "
+                   f"{t_l:.2f} s vs {t_s:.2f} s = 1/{t_s / max(t_l, 1e-9):.1f} "
+                   "(target: at most 1/10, goal 1/50).")
+    cs = [(i, r) for i, r in other.values() if i.family == "crama-spieksma"]
+    if cs:
+        slower = [i.name for i, r in cs if "highs" in r and
+                  r["lagrangian-exact"].time > r["highs"].time]
+        out.append(f"- LP-gap 3-AP: {sum(r['lagrangian-exact'].proven for _, r in cs)}/"
+                   f"{len(cs)} proven; slower than HiGHS alone on "
+                   f"{len(slower)} ({', '.join(slower) or 'none'}).")
+    trk = [(i, r) for i, r, _ in plain if i.family.startswith("tracking")]
+    if trk:
+        worst = max((r.gap or 0.0) for _, r in trk)
+        out.append(f"- Plain `lagrangian`, S-D with dummies, 100 iterations: worst gap "
+                   f"{_pct(worst)} over {len(trk)} instances (target <= 1%).")
+    small = [(label, row["auto"][0]) for label, _, row in lat if "auto" in row and
+             ("M=2" in label or "M=5" in label or "M=10" in label or "n=5" in label
+              or "n=10" in label)]
+    if small:
+        out.append("- `auto` latency, n <= 10 (target <= 1 ms): " + "; ".join(
+            f"{label}: {1e3 * t:.2f} ms" for label, t in small) + ".")
+    for label, t_sp, t_fb, t_lx in lapres:
+        if t_sp and t_lx:
+            out.append(f"- {label}: lapx {t_sp / t_lx:.2f}x faster than scipy "
+                       "(target >= 2x when installed).")
+        if t_sp and t_fb:
+            out.append(f"- {label}: without lapx {t_fb / t_sp:.3f}x scipy's time "
+                       "(target <= 1.1x).")
+    out.append("- Memory: candidates only (tests/test_lagrangian.py::"
+               "test_memory_follows_candidates_not_sizes solves sizes 3000^4 with "
+               "~13,500 candidates).")
+    return out
+
+
+def write_report(path: Path, parts: list[str]) -> None:
+    path.parent.mkdir(parents=True, exist_ok=True)
+    fd, tmp = tempfile.mkstemp(dir=path.parent, prefix=".bench-", suffix=".md")
+    with os.fdopen(fd, "w") as fh:
+        fh.write("\n".join(parts) + "\n")
+    os.replace(tmp, path)
+
+
+# ----------------------------------------------------------------------- main
+def main(argv=None) -> int:
+    ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    ap.add_argument("--quick", action="store_true", help="small instances only (smoke run)")
+    ap.add_argument("--out", default=str(ROOT / "docs" / "benchmarks-sd.md"))
+    ap.add_argument("--ap-dir", default=str(ROOT.parent / "shared" / "ap_instances"))
+    ap.add_argument("--time-limit", type=float, default=60.0,
+                    help="per-solve limit for the exact methods (s)")
+    ap.add_argument("--cpsat-limit", type=float, default=20.0,
+                    help="per-solve limit for OR-Tools CP-SAT (s), to keep the run short")
+    ap.add_argument("--fixed-time", type=float, default=1.0,
+                    help="time budget for the gap-after-fixed-time table (s)")
+    ap.add_argument("--seed", type=int, default=2024)
+    ap.add_argument("--lapx-path", default=None,
+                    help="directory holding lapx (pip install --target DIR lapx) for the "
+                         "2-D LAP table only")
+    ap.add_argument("--all-peers", action="store_true",
+                    help="run every peer on every 3-AP instance (an hour or more)")
+    ap.add_argument("--reference-all", action="store_true",
+                    help="run scipy (the reference) on all 120 3-AP instances, the other "
+                         "peers on the subset (about 17 min instead of 8)")
+    args = ap.parse_args(argv)
+    t_start = time.perf_counter()
+    lines_log: list[str] = []
+
+    def log(msg: str) -> None:
+        lines_log.append(msg)
+        print(msg, flush=True)
+
+    solvers = [s for s in EXACT if available(s)]
+    missing = [s for s in EXACT if s not in solvers]
+    rng = np.random.default_rng(args.seed)
+    header = machine_info()
+    warm_up(solvers + ["lagrangian"])
+
+    # 1. shared 3-AP instances
+    ap_list = ap_instances(Path(args.ap_dir), args.quick)
+    if args.all_peers:
+        for inst in ap_list:
+            inst.peers = True
+    ref_all = args.reference_all and not args.all_peers
+    # 2. LP-gap 3-AP (Crama-Spieksma-style)
+    cs = [Instance("crama-spieksma", f"cs-n{n}-{k}", n, crama_spieksma(rng, n))
+          for n in ((10, 15) if args.quick else (10, 15, 20, 25)) for k in (1, 2)]
+    # 3. tracking S-D with dummies
+    trk = [Instance(f"tracking N={N}", f"trk-N{N}-t{t}", t, tracking(rng, N, t))
+           for N in (3, 4, 5, 6) for t in ((10, 25) if args.quick else (10, 25, 50))]
+    rows = exact_section(ap_list + cs + trk, solvers, args.time_limit, args.cpsat_limit, log,
+                         ref_all)
+
+    big = [i for i in ap_list if i.name in ("ap3.50.1", "balas-n26-instance01")]
+    big += [cs[-1], trk[-1]]
+    fixed = fixed_time_section(big, ["lagrangian"] + solvers, args.fixed_time, log)
+    plain = plain_section(trk + cs, log)
+
+    # 4. latency of small problems (auto)
+    groups = []
+    for M in (2, 5, 10):
+        for pd, cl in ((1.0, 0.0), (0.9, 1.0)):
+            probs = lu2013_problems(rng, M, pd, cl, 40 if not args.quick else 10)
+            if probs is not None:
+                groups.append((f"paper 002, M={M}, P_D={pd}, clutter {cl}", probs))
+    for n in (5, 10):
+        groups.append((f"3-AP n={n}, uniform random costs",
+                       [AssignmentProblem.dense(rng.random((n, n, n))) for _ in range(20)]))
+    lat = latency_section(groups, ["auto"] + [s for s in ("highs", "scipy") if s in solvers],
+                          log)
+    lapres = lap_section(args.quick, args.lapx_path, log)
+    total = time.perf_counter() - t_start
+
+    # ------------------------------------------------------------- report
+    out = Path(args.out)
+    png = out.with_suffix(".png")
+    plotted = plot(rows, png, solvers)
+    cmd = "python benchmarks/sd_scaling.py" + (" " + " ".join(argv or sys.argv[1:])
+                                               if (argv or sys.argv[1:]) else "")
+    P = ["# S-D assignment at scale: Lagrangian relaxation vs MILP/CP solvers", "",
+         f"Generated by `{cmd}` (one process, {total / 60:.1f} min).  "
+         "Timings are in-process wall-clock seconds of `assocopt.solve` (model building "
+         "included).  This machine has 2 cores that other people's test runs shared "
+         "during the run, so single timings are noisy (see the load averages); ratios "
+         "between methods measured side by side are the robust numbers.", ""]
+    P += ["## What is compared", "",
+          "- `lagrangian`: Lagrangian relaxation of N-2 axes to a 2-D assignment "
+          "(Pattipati et al. 1992, Deb et al. 1997), Polyak subgradient steps, recursive "
+          "2-D recovery plus axis-wise local search; reports bound, objective and gap, "
+          "`OPTIMAL` only with a proof.",
+          "- `lagrangian-exact`: the same ascent, then reduced-cost fixing with the LAP "
+          "duals; the candidates whose bound lies below a threshold T form a *window* "
+          "that holds every solution cheaper than T; windows grow until T reaches the "
+          "incumbent and are solved by an exact-cover search (small), CP-SAT (integer "
+          "costs, <= 1,500 candidates, 1 s budget) or HiGHS (stopped at the proven "
+          "bound).  Proven optimum, no tolerance beyond floating-point round-off.",
+          "- `highs`: HiGHS MIP through highspy on the full ILP; `scipy`: "
+          "scipy.optimize.milp (HiGHS inside scipy); `ortools-cpsat`: CP-SAT on the "
+          "exact-cover model (float costs scaled to integers: `FEASIBLE` only).", "",
+          "Why it is fast: the Lagrangian bound is the LP bound at the cost of a few "
+          "hundred 2-D assignments, and it prices every candidate: on Grundel n = 50 the "
+          "window below the optimum holds about 14,000 of the 125,000 candidates and "
+          "has no solution (proving the bound takes HiGHS well under a second), and the "
+          "next one finds the optimum.  The MILP solvers spend most of their time in "
+          "presolve, the root LP of the full model and heuristics.", ""]
+    P += ["## Machine", ""] + header + [
+        f"- load average at end: {', '.join(f'{v:.2f}' for v in os.getloadavg())}",
+        f"- per-solve time limit {args.time_limit:g} s (CP-SAT: {args.cpsat_limit:g} s); "
+        f"runs stopped by it count with the limit as their time; not installed / "
+        f"not registered: {', '.join(missing) or 'none'}", ""]
+    ap_rows = {k: v for k, v in rows.items() if v[0].family in ("grundel", "balas-saltzman")}
+    P += ["## Time to proven optimum", "",
+          "Total seconds per family and size; `(p/k)`: proven optimal in p of k runs. "
+          "Peers (HiGHS, scipy, CP-SAT) run on every 3-AP instance with n <= 10 and on "
+          "the first instance of each larger size" +
+          (" (scipy on all 120: `--reference-all`)" if ref_all else "") +
+          "; `lagrangian-exact` on all 120.  Every "
+          "proven objective is checked against the recorded optimum (or the other "
+          "methods): a mismatch would be flagged WRONG.", ""]
+    P += family_table(rows, solvers) + [""]
+    la = [r["lagrangian-exact"] for _, r in ap_rows.values()]
+    if la:
+        P += [f"`lagrangian-exact` on all {len(la)} shared 3-AP instances: "
+              f"{sum(r.proven for r in la)} proven optimal, "
+              f"{sum(not r.info.get('correct', True) for r in la)} wrong, "
+              f"total {sum(r.time for r in la):.2f} s, slowest "
+              f"{max(r.time for r in la):.2f} s.", ""]
+    P += ["### Ratios against scipy.optimize.milp (same instances, same run)", "",
+          "Shared 3-AP instances:", ""] + ratio_lines(ap_rows, solvers) + [""]
+    other = {k: v for k, v in rows.items() if k not in ap_rows}
+    P += ["LP-gap 3-AP and tracking S-D instances:", ""] + ratio_lines(other, solvers) + [""]
+    if plotted:
+        P += [f"![time to proven optimum versus n]({png.name})", ""]
+    P += ["## Gap after a fixed time", "",
+          f"Each method stopped after {args.fixed_time:g} s (`time_limit`); relative gap "
+          "`(objective - bound) / |objective|` (n/a: no bound or no solution).", "",
+          "| instance | K | " + " | ".join(["lagrangian"] + solvers) + " |",
+          "|---|---|" + "---|" * (len(solvers) + 1)]
+    for name, (inst, res) in fixed.items():
+        P.append(f"| {name} | {inst.problem.n_candidates} | " +
+                 " | ".join(_pct(res[s].gap) for s in ["lagrangian"] + solvers) + " |")
+    P += ["", "## Plain `lagrangian`: gap after 100 iterations", "",
+          "`solve(p, 'lagrangian', max_iter=100, gap_tol=0)`; each iteration is one pass "
+          "over the candidates, one 2-D assignment and the primal recovery.", "",
+          "| instance | sizes | K | gap | iterations | ms / iteration |", "|---|---|---|---|---|---|"]
+    for inst, r, per in plain:
+        P.append(f"| {inst.name} | {inst.problem.sizes} | {inst.problem.n_candidates} | "
+                 f"{_pct(r.gap)} | {r.info.get('iterations')} | {1e3 * per:.2f} |")
+    P += ["", "## Small problems: in-process latency of `solver=\"auto\"`", "",
+          "Median (max) milliseconds per `solve()` call over the listed problems (distinct "
+          "random draws), after warm-up; `auto` picks `lagrangian-exact` for N >= 3.", "",
+          "| problems | K (first) | " + " | ".join(lat[0][2]) + " |" if lat else "",
+          "|---|---|" + "---|" * (len(lat[0][2]) if lat else 0)]
+    for label, K, row in lat:
+        P.append(f"| {label} | {K} | " + " | ".join(
+            f"{1e3 * v[0]:.2f} ({1e3 * v[1]:.1f}), {v[2]}/{v[3]} optimal"
+            for v in row.values()) + " |")
+    P += ["", "## 2-D assignment engines", "",
+          "Best of 7 interleaved repeats, in a separate process (lapx from `--lapx-path` only there).  "
+          "`assocopt scipy path`: `linear_assignment(C, 'scipy')`, what runs when lapx "
+          "is not installed; `lapx`: `linear_assignment(C, 'lapx')` (lapx's `lapjvh`), "
+          "what `auto` and the `lapjv` back end use when it is.", "",
+          "| problem | scipy LSA s | assocopt scipy path s | lapx s | scipy / lapx | "
+          "scipy path / scipy |", "|---|---|---|---|---|---|"]
+    for label, t_sp, t_fb, t_lx in lapres:
+        cells = ["-" if v is None else f"{v:.4f}" for v in (t_sp, t_fb, t_lx)]
+        r1 = f"{t_sp / t_lx:.2f}x" if t_sp and t_lx else "-"
+        r2 = f"{t_fb / t_sp:.3f}" if t_sp and t_fb else "-"
+        P.append(f"| {label} | " + " | ".join(cells) + f" | {r1} | {r2} |")
+    P += ["", "## Targets of the issue, as measured in this run", ""] + targets(
+        rows, ap_rows, other, plain, lat, lapres) + [""]
+    P += ["", "## Log", "", "```"] + lines_log + ["```"]
+    write_report(out, P)
+    print(f"wrote {out}" + (f" and {png}" if plotted else ""), flush=True)
+    return 0
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())
