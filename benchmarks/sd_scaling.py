@@ -317,7 +317,6 @@ def _fmt_t(r: Run | None) -> str:
 
 
 def machine_info() -> list[str]:
-    import highspy  # noqa: F401
     import importlib.metadata as md
     cpu = platform.processor() or "unknown"
     try:
@@ -603,7 +602,8 @@ def main(argv=None) -> int:
     P += ["", "## Plain `lagrangian`: gap after 100 iterations", "",
           "`solve(p, 'lagrangian', max_iter=100, gap_tol=0)`; each iteration is one pass "
           "over the candidates, one 2-D assignment and the primal recovery.", "",
-          "| instance | sizes | K | gap | iterations | ms / iteration |", "|---|---|---|---|---|---|"]
+          "| instance | sizes | K | gap | iterations | ms / iteration |",
+          "|---|---|---|---|---|---|"]
     for inst, r, per in plain:
         P.append(f"| {inst.name} | {inst.problem.sizes} | {inst.problem.n_candidates} | "
                  f"{_pct(r.gap)} | {r.info.get('iterations')} | {1e3 * per:.2f} |")
@@ -617,7 +617,8 @@ def main(argv=None) -> int:
             f"{1e3 * v[0]:.2f} ({1e3 * v[1]:.1f}), {v[2]}/{v[3]} optimal"
             for v in row.values()) + " |")
     P += ["", "## 2-D assignment engines", "",
-          "Best of 7 interleaved repeats, in a separate process (lapx from `--lapx-path` only there).  "
+          "Best of 7 interleaved repeats, in a separate process (lapx from `--lapx-path` "
+          "only there).  "
           "`assocopt scipy path`: `linear_assignment(C, 'scipy')`, what runs when lapx "
           "is not installed; `lapx`: `linear_assignment(C, 'lapx')` (lapx's `lapjvh`), "
           "what `auto` and the `lapjv` back end use when it is.", "",

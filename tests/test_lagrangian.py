@@ -359,8 +359,6 @@ def test_lapjv_backend_matches_scipy_lsa(method):
 def _instances(max_n: int | None, min_n: int = 0):
     if not AP_INSTANCES.is_dir():
         return []
-    sys.path.insert(0, str(AP_INSTANCES))
-    from load import known_value, load   # noqa: F401  (the shared folder's loader)
     out = []
     for path in sorted((AP_INSTANCES / "grundel_ap3").glob("ap3.*.txt")) + \
             sorted((AP_INSTANCES / "balas_saltzman" / "split").glob("balas-n*.txt")):
