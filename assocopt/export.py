@@ -25,6 +25,7 @@ from typing import Any
 import numpy as np
 
 from .errors import AssocoptError, InvalidProblemError
+from .io import replace_atomically
 from .problem import AssignmentProblem
 
 __all__ = ["MODEL_FORMATS", "PUBLIC_WRITERS", "export_model", "solve_model_file",
@@ -45,24 +46,6 @@ def _model_format(path: Path) -> str:
                             f"{path.suffix or '(none)'!r}; use .mps or .lp")
     return fmt
 
-
-def _replace_atomically(path: Path, write: Any) -> None:
-    """Call ``write(tmp_path)`` then move the file into place (same folder, same suffix)."""
-    directory = path.parent if str(path.parent) else Path(".")
-    fd, tmp = tempfile.mkstemp(dir=directory, prefix=f".{path.stem}.", suffix=path.suffix)
-    os.close(fd)
-    try:
-        write(Path(tmp))
-        umask = os.umask(0)
-        os.umask(umask)
-        os.chmod(tmp, 0o666 & ~umask)
-        os.replace(tmp, path)
-    except BaseException:
-        try:
-            os.unlink(tmp)
-        except OSError:
-            pass
-        raise
 
 
 def export_model(problem: AssignmentProblem, path: str | os.PathLike[str], *,
@@ -109,7 +92,7 @@ def export_model(problem: AssignmentProblem, path: str | os.PathLike[str], *,
         if status == highspy.HighsStatus.kError:
             raise AssocoptError(f"{path}: HiGHS could not write the model")
 
-    _replace_atomically(path, write)
+    replace_atomically(path, write)
     return {"path": str(path), "format": fmt, "columns": int(model.A.shape[1]),
             "rows": int(model.A.shape[0]), "integer": model.is_mip,
             "relaxation": relax}
@@ -183,11 +166,11 @@ def write_public(problem: AssignmentProblem, path: str | os.PathLike[str], forma
             raise InvalidProblemError(f"the balas-saltzman-split format holds n x n x n "
                                       f"problems; this one has sizes {list(C.shape)}")
         text = values + "\n"
-    _replace_atomically(path, lambda tmp: tmp.write_text(text, encoding="utf-8"))
+    replace_atomically(path, lambda tmp: tmp.write_text(text, encoding="utf-8"))
     if format == "grundel" and problem.optimum is not None:
         sol = path.with_suffix(".sol")
         body = f"OPT: {_number(problem.optimum)}\n"
-        _replace_atomically(sol, lambda tmp: tmp.write_text(body, encoding="utf-8"))
+        replace_atomically(sol, lambda tmp: tmp.write_text(body, encoding="utf-8"))
         written.append(sol)
     return written
 

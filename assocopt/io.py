@@ -743,15 +743,15 @@ def _dump_rows(rows: Iterable[str], indent: int) -> str:
     return "[\n" + pad + (",\n" + pad).join(rows) + "\n" + " " * indent + "]"
 
 
-def _atomic_write(path: Path, text: str) -> None:
+def replace_atomically(path: str | os.PathLike[str], write: Any) -> None:
+    """Call ``write(tmp_path)`` on a temporary file beside ``path``, then move it into
+    place with ``os.replace``: an interrupted write never leaves a partial file."""
     path = Path(path)
     directory = path.parent if str(path.parent) else Path(".")
-    fd, tmp = tempfile.mkstemp(dir=directory, prefix=f".{path.name}.", suffix=".tmp")
+    fd, tmp = tempfile.mkstemp(dir=directory, prefix=f".{path.stem}.", suffix=path.suffix)
+    os.close(fd)
     try:
-        with os.fdopen(fd, "w", encoding="utf-8", newline="\n") as f:
-            f.write(text)
-            f.flush()
-            os.fsync(f.fileno())
+        write(Path(tmp))
         umask = os.umask(0)
         os.umask(umask)
         os.chmod(tmp, 0o666 & ~umask)
@@ -762,6 +762,15 @@ def _atomic_write(path: Path, text: str) -> None:
         except OSError:
             pass
         raise
+
+
+def _atomic_write(path: Path, text: str) -> None:
+    def write(tmp: Path) -> None:
+        with open(tmp, "w", encoding="utf-8", newline="\n") as f:
+            f.write(text)
+            f.flush()
+            os.fsync(f.fileno())
+    replace_atomically(path, write)
 
 
 def instance_to_json(problem: AssignmentProblem, *, optimum: float | None = None,
