@@ -1,0 +1,237 @@
+"""Exact solving of candidate *windows* (exact mode): search, CP-SAT and HiGHS.
+
+A window is a subset of the candidates left by reduced-cost fixing.  Small windows
+go to the depth-first exact-cover search :func:`_cover_search`, integer-cost ones of
+moderate size to CP-SAT (:func:`_cpsat`), the rest to HiGHS (:func:`_ilp`).  The
+tuning constants that route windows between them live here too; the policy that
+grows windows is :meth:`~.backend._LagrangianBase._close_gap`.
+"""
+
+from __future__ import annotations
+
+import functools
+import math
+import time
+from typing import Any
+
+import numpy as np
+import scipy.sparse as sp
+
+from ...problem import AssignmentProblem
+from ..base import SolveOptions
+from .ascent import _State
+from .options import OPT_TOL
+
+#: During the ascent, fixing windows up to this size are tried by a short search.
+_PROBE_SEARCH_MAX = 80
+#: Windows of at most this many candidates are first tried by :func:`_cover_search`
+#: with at most this many nodes (about 25 ms): it settles most windows in
+#: milliseconds (the reduced costs prune hard), and gives up quickly on the rest
+#: (Balas-Saltzman windows of 200+ candidates), which go to CP-SAT or HiGHS.
+_SEARCH_MAX = 2000
+_SEARCH_NODES = 5000
+#: Windows up to this many candidates (integer costs) go to CP-SAT, larger ones to
+#: HiGHS: CP-SAT settles the small exact-cover windows of Balas-Saltzman instances
+#: several times faster, HiGHS's LP wins on large ones (measured, Grundel n = 50).
+_CPSAT_MAX = 1500
+#: Seconds CP-SAT may spend on one window before HiGHS takes it over.
+_CPSAT_BUDGET = 1.0
+#: Extra HiGHS settings for the restricted ILPs.  Empty: turning presolve or
+#: feasibility jump off was tried on Grundel n = 50 and did not pay, so HiGHS runs
+#: with its defaults (plus the objective target set below).
+_HIGHS_OPTIONS: dict[str, Any] = {}
+
+
+def _grow(n: int, integer: bool) -> int:
+    """Least size of the next window: integer thresholds step by one unit while that
+    grows the window by a quarter; real ones double it."""
+    return int(n * (1.25 if integer else 2.0)) + 1
+
+
+@functools.lru_cache(maxsize=1)
+def _has_ortools() -> bool:
+    import importlib.util
+    try:
+        return importlib.util.find_spec("ortools") is not None
+    except (ImportError, ValueError):
+        return False
+
+
+def _uncovered(problem: AssignmentProblem, pos: np.ndarray) -> np.ndarray:
+    """Constraint rows that none of the candidates ``pos`` covers."""
+    T = problem.tuples[pos]
+    rows = (T - 1 + problem.row_offsets[None, :])[T > 0]
+    return np.flatnonzero(np.bincount(rows, minlength=problem.n_rows) == 0)
+
+
+def _coverage(problem: AssignmentProblem, pos: np.ndarray) -> sp.csr_matrix:
+    T = problem.tuples[pos]
+    real = T > 0
+    rows = (T - 1 + problem.row_offsets[None, :])[real]
+    cols = np.broadcast_to(np.arange(len(T))[:, None], T.shape)[real]
+    A = sp.csr_matrix((np.ones(len(rows)), (rows, cols)), shape=(problem.n_rows, len(T)))
+    A.sort_indices()
+    return A
+
+
+def _cover_search(problem: AssignmentProblem, pos: np.ndarray, red: np.ndarray,
+                  base: float, cap: float, node_limit: int = 20_000
+                  ) -> tuple[np.ndarray | None, bool]:
+    """Cheapest exact cover by the candidates ``pos`` costing less than ``cap``.
+
+    Depth-first branch and bound for small windows.  Every solution ``S`` costs at
+    least ``base + sum_{k in S} red[k]`` (``red >= 0``, from the Lagrangian duals, see
+    :meth:`_Relaxation.fixing_bounds`); a branch is cut when that bound, plus for each
+    uncovered row the least share ``red[k] / rows(k)`` of a candidate covering it,
+    reaches the cap or the best cost found.  Branches on the uncovered row with the
+    fewest usable candidates (Knuth's rule for exact cover), cheapest reduced cost
+    first.  Returns ``(selection or None, complete)``;
+    ``complete`` is False when the node limit stopped the search (nothing proven).
+    """
+    K = len(pos)
+    T = problem.tuples[pos]
+    rows_of = np.where(T > 0, T - 1 + problem.row_offsets[None, :], -1).tolist()
+    cost = problem.costs[pos].tolist()
+    rd = np.asarray(red, np.float64).tolist()
+    cols = [[r for r in rk if r >= 0] for rk in rows_of]
+    masks = [sum(1 << r for r in rows) for rows in cols]
+    R = problem.n_rows
+    by_row: list[list[int]] = [[] for _ in range(R)]
+    for k in range(K):
+        if math.isfinite(rd[k]):
+            for r in cols[k]:
+                by_row[r].append(k)
+    if any(not b for b in by_row):
+        return None, True
+    for b in by_row:
+        b.sort(key=lambda k: (rd[k], cost[k]))
+    share = [min(rd[k] / len(cols[k]) for k in b) for b in by_row]
+    msum = [sum(share[r] for r in cols[k]) for k in range(K)]
+    full = (1 << R) - 1
+    tol = OPT_TOL * max(1.0, abs(cap)) if math.isfinite(cap) else 0.0
+    best = [cap - tol, None]
+    nodes = [0]
+    chosen: list[int] = []
+
+    def search(covered: int, acc: float, racc: float, rest: float) -> bool:
+        if covered == full:
+            if acc < best[0]:
+                best[0], best[1] = acc, list(chosen)
+            return True
+        nodes[0] += 1
+        if nodes[0] > node_limit:
+            return False
+        if base + racc + rest >= best[0]:
+            return True
+        # branch on the uncovered row with the fewest usable candidates
+        opts = None
+        free = ~covered & full
+        while free:
+            low = free & -free
+            r = low.bit_length() - 1
+            free ^= low
+            o = [k for k in by_row[r] if not masks[k] & covered]
+            if opts is None or len(o) < len(opts):
+                opts = o
+                if len(o) <= 1:
+                    break
+        for k in opts:
+            r2 = racc + rd[k]
+            if base + r2 >= best[0]:
+                break                    # sorted by red: the rest cannot do better
+            chosen.append(k)
+            ok = search(covered | masks[k], acc + cost[k], r2, rest - msum[k])
+            chosen.pop()
+            if not ok:
+                return False
+        return True
+
+    complete = search(0, 0.0, 0.0, sum(share))
+    sel = None if best[1] is None else np.sort(pos[np.array(best[1], np.int64)])
+    return sel, complete
+
+
+def _ilp(problem: AssignmentProblem, pos: np.ndarray, st: _State, options: SolveOptions,
+         deadline: float | None, target: float | None, start: bool) -> tuple[str, float | None]:
+    """HiGHS on the candidates ``pos``; offers any solution found to ``st``.
+
+    ``target``: stop as soon as a solution this good is found (it is then optimal:
+    ``target`` is a proven lower bound).  ``start``: pass the incumbent (which must be
+    among ``pos``) as the starting solution.  Returns HiGHS's model status name and
+    the objective of its solution (None when it has none).
+    """
+    import highspy
+
+    from ...formulation import LinearModel
+    from ..highs import highs_from_model
+
+    K = len(pos)
+    model = LinearModel(c=problem.costs[pos].astype(np.float64), A=_coverage(problem, pos),
+                        row_lower=np.ones(problem.n_rows), row_upper=np.ones(problem.n_rows),
+                        lb=np.zeros(K), ub=np.ones(K), integrality=np.ones(K, np.uint8))
+    limit = None if deadline is None else max(deadline - time.perf_counter(), 1e-3)
+    extra: dict[str, Any] = dict(_HIGHS_OPTIONS)
+    if target is not None and math.isfinite(target):
+        extra["objective_target"] = float(target)
+    h = highs_from_model(model, SolveOptions(time_limit=limit, mip_gap=0.0,
+                                             threads=options.threads,
+                                             verbose=options.verbose, extra=extra))
+    if start and st.incumbent is not None:
+        x0 = highspy.HighsSolution()
+        x0.col_value = np.isin(pos, st.incumbent).astype(np.float64).tolist()
+        x0.value_valid = True
+        h.setSolution(x0)
+    h.run()
+    status = h.getModelStatus().name
+    z = None
+    if h.getInfo().primal_solution_status == 2:
+        sel = pos[np.asarray(h.getSolution().col_value) > 0.5]
+        if problem.violations(sel) is None:
+            st.offer(sel)
+            z = math.fsum(problem.costs[sel].tolist())
+    return status, z
+
+
+def _cpsat(problem: AssignmentProblem, pos: np.ndarray, st: _State, options: SolveOptions,
+           deadline: float | None, lo: float, cap: float, start: bool) -> tuple[str, float | None]:
+    """CP-SAT on the candidates ``pos`` (integer costs), objective at most ``cap``.
+
+    ``lo`` (a proven lower bound) is not passed to CP-SAT, see below; ``cap`` is the
+    largest objective of interest.  Returns ``("kOptimal", z)``, ``("kInfeasible",
+    None)`` (nothing in the window costs at most ``cap``) or ``("kTimeLimit", z)``.
+    """
+    from ortools.sat.python import cp_model
+
+    K = len(pos)
+    m = cp_model.CpModel()
+    x = [m.NewBoolVar("") for _ in range(K)]
+    A = _coverage(problem, pos)
+    for r in range(problem.n_rows):
+        m.AddExactlyOne([x[k] for k in A.indices[A.indptr[r]:A.indptr[r + 1]].tolist()])
+    cost = problem.costs[pos].astype(np.int64).tolist()
+    obj = cp_model.LinearExpr.WeightedSum(x, cost)
+    m.Add(obj <= int(math.floor(cap)))
+    # no "obj >= lo" constraint: with cap == lo it turns the cut into an equality,
+    # which CP-SAT propagates poorly (measured: seconds instead of milliseconds)
+    m.Minimize(obj)
+    if start and st.incumbent is not None:
+        on = np.isin(pos, st.incumbent)
+        for k in range(K):
+            m.AddHint(x[k], bool(on[k]))
+    solver = cp_model.CpSolver()
+    solver.parameters.num_workers = int(options.threads or 1)
+    solver.parameters.log_search_progress = bool(options.verbose)
+    if deadline is not None:
+        solver.parameters.max_time_in_seconds = max(deadline - time.perf_counter(), 1e-3)
+    code = solver.Solve(m)
+    z = None
+    if code in (cp_model.OPTIMAL, cp_model.FEASIBLE):
+        sel = pos[np.array([solver.BooleanValue(v) for v in x], bool)]
+        if problem.violations(sel) is None:
+            st.offer(sel)
+            z = math.fsum(problem.costs[sel].tolist())
+    if code == cp_model.OPTIMAL:
+        return "kOptimal", z
+    if code == cp_model.INFEASIBLE:
+        return "kInfeasible", None
+    return "kTimeLimit", z
