@@ -24,6 +24,8 @@ solver.  NaN and ``-inf`` are errors.
 
 from __future__ import annotations
 
+import functools
+
 from dataclasses import dataclass, field
 from typing import Any, Sequence
 
@@ -277,10 +279,13 @@ class AssignmentProblem:
         """Number of coverage constraints: one per real index, ``sum(n_s)``."""
         return int(sum(self.sizes))
 
-    @property
+    @functools.cached_property
     def row_offsets(self) -> np.ndarray:
-        """Row of real index 1 of each axis in the constraint matrix."""
-        return np.concatenate([[0], np.cumsum(self.sizes)[:-1]]).astype(np.int64)
+        """Row of real index 1 of each axis in the constraint matrix (cached: the
+        problem is immutable, and small solves call this several times)."""
+        off = np.concatenate([[0], np.cumsum(self.sizes)[:-1]]).astype(np.int64)
+        off.setflags(write=False)
+        return off
 
     def coverage_matrix(self) -> sp.csr_matrix:
         """CSR matrix ``A`` (sum n_s x K): ``A[r, k] = 1`` if candidate k covers row r.
@@ -302,13 +307,18 @@ class AssignmentProblem:
 
         Any such index makes the problem infeasible.
         """
+        return list(self._uncovered)
+
+    @functools.cached_property
+    def _uncovered(self) -> tuple[tuple[int, int], ...]:
         hit = np.zeros(self.n_rows, dtype=bool)
         T = self.tuples
         real = T > 0
         hit[(T - 1 + self.row_offsets[None, :])[real]] = True
         missing = np.flatnonzero(~hit)
         axes = np.searchsorted(self.row_offsets, missing, side="right") - 1
-        return [(int(a), int(r - self.row_offsets[a] + 1)) for a, r in zip(axes, missing)]
+        return tuple((int(a), int(r - self.row_offsets[a] + 1))
+                     for a, r in zip(axes, missing))
 
     def row_label(self, row: int) -> str:
         """Human-readable name of constraint row ``row``: its axis and real index."""

@@ -8,7 +8,7 @@ that back end is asked for, and then fails with a message naming the package.
 from .base import (Backend, RawResult, SolveOptions, available, get_backend,
                    register, registered)
 from . import highs, scipy_milp, scipy_lsa, bruteforce, greedy  # noqa: F401  (register)
-from . import lap, lagrangian  # noqa: F401  (register)
+from . import lap, lagrangian, bnb  # noqa: F401  (register)
 from . import ortools_cpsat, ortools_mip, cvxpy_backend  # noqa: F401  (register)
 
 __all__ = ["Backend", "RawResult", "SolveOptions", "available", "get_backend",

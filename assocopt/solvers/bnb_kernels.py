@@ -1,0 +1,469 @@
+"""Compiled kernels of the ``bnb`` back end (numba, nopython): a dense Hungarian
+method with duals, the Lagrangian relaxation to a 2-D assignment with misses, and a
+depth-first exact-cover branch and bound on reduced costs.
+
+Importing this module imports numba; :mod:`assocopt.solvers.bnb` does so only inside
+``solve``.  Functions are compiled on first use and cached on disk (``cache=True``).
+
+Notation (as in :mod:`assocopt.solvers.lagrangian`): ``K`` candidates, ``N`` axes,
+``G[k, s]`` the global row of the real index of candidate ``k`` on axis ``s`` (-1 for
+the dummy), ``E`` real indices in all.  Axes ``a, b`` are kept, the others relaxed
+with multipliers ``y[e]``.  For *any* ``y`` and any exact cover ``X``:
+
+    cost(X) = sum_e y[e] + sum_{k in X} r[k],   r[k] = c[k] - sum_{e in k} y[e],
+
+so ``base + sum_{k in X} max(r[k], 0)`` with ``base = sum(y) + sum_k min(r[k], 0)``
+bounds every solution from below: the bound is valid whatever the multipliers, and
+the ascent only makes it tight.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from numba import njit
+
+INF = np.inf
+
+# DFS outcomes
+COMPLETE = 0       # search exhausted: the incumbent (if any) is optimal
+BUDGET = 1         # node budget spent
+
+
+@njit(cache=True)
+def hungarian(A):
+    """Min-cost perfect matching of the square matrix ``A`` (``inf`` = forbidden).
+
+    Shortest augmenting paths with potentials.  Returns ``(ok, col_of_row, u, v,
+    cost)`` with ``u[i] + v[j] <= A[i, j]`` for all finite entries, equality on the
+    matching, and ``cost = sum(u) + sum(v)``; ``ok`` is False if no finite perfect
+    matching exists.
+    """
+    n = A.shape[0]
+    u = np.zeros(n + 1)
+    v = np.zeros(n + 1)
+    p = np.zeros(n + 1, np.int64)        # p[j]: row (1-based) matched to column j
+    way = np.zeros(n + 1, np.int64)
+    minv = np.empty(n + 1)
+    used = np.empty(n + 1, np.bool_)
+    for i in range(1, n + 1):
+        p[0] = i
+        j0 = 0
+        minv[:] = INF
+        used[:] = False
+        while True:
+            used[j0] = True
+            i0 = p[j0]
+            delta = INF
+            j1 = -1
+            ui0 = u[i0]
+            for j in range(1, n + 1):
+                if not used[j]:
+                    cur = A[i0 - 1, j - 1] - ui0 - v[j]
+                    if cur < minv[j]:
+                        minv[j] = cur
+                        way[j] = j0
+                    if minv[j] < delta:
+                        delta = minv[j]
+                        j1 = j
+            if j1 < 0 or delta == INF:
+                return False, np.zeros(n, np.int64), u[1:], v[1:], INF
+            for j in range(n + 1):
+                if used[j]:
+                    u[p[j]] += delta
+                    v[j] -= delta
+                else:
+                    minv[j] -= delta
+            j0 = j1
+            if p[j0] == 0:
+                break
+        while True:
+            j1 = way[j0]
+            p[j0] = p[j1]
+            j0 = j1
+            if j0 == 0:
+                break
+    col = np.empty(n, np.int64)
+    cost = 0.0
+    for j in range(1, n + 1):
+        col[p[j] - 1] = j - 1
+        cost += A[p[j] - 1, j - 1]
+    return True, col, u[1:], v[1:], cost
+
+
+
+@njit(cache=True)
+def prepare(T, off, sizes, c, a, b):
+    """The kernels' arrays from the tuple array, in one pass (a counting sort).
+
+    Returns ``(G, ptr, lst, y0, axis_of, int_costs, plain)``: global rows, the CSR
+    lists of candidates per row (in candidate order), starting multipliers (each
+    relaxed row's least per-index cost share; 0 on kept rows), the axis of each row,
+    whether all costs are integers, and whether the kept axes need no misses.
+    """
+    K, N = T.shape
+    E = 0
+    for s in range(N):
+        E += sizes[s]
+    G = np.empty((K, N), np.int64)
+    ptr = np.zeros(E + 1, np.int64)
+    axis_of = np.empty(E, np.int64)
+    for s in range(N):
+        for i in range(sizes[s]):
+            axis_of[off[s] + i] = s
+    y0 = np.full(E, INF)
+    int_costs = True
+    plain = sizes[a] == sizes[b]
+    for k in range(K):
+        nreal = 0
+        for s in range(N):
+            t = T[k, s]
+            if t > 0:
+                e = off[s] + t - 1
+                G[k, s] = e
+                ptr[e + 1] += 1
+                nreal += 1
+            else:
+                G[k, s] = -1
+        share = c[k] / max(nreal, 1)
+        for s in range(N):
+            e = G[k, s]
+            if e >= 0 and share < y0[e]:
+                y0[e] = share
+        if c[k] != np.round(c[k]) or abs(c[k]) >= 2.0 ** 52:
+            int_costs = False
+        if (T[k, a] == 0) != (T[k, b] == 0):
+            plain = False
+    for e in range(E):
+        ptr[e + 1] += ptr[e]
+        s = axis_of[e]
+        if s == a or s == b or y0[e] == INF:
+            y0[e] = 0.0
+    fill = ptr[:-1].copy()
+    lst = np.empty(ptr[E], np.int64)
+    for k in range(K):
+        for s in range(N):
+            e = G[k, s]
+            if e >= 0:
+                lst[fill[e]] = k
+                fill[e] += 1
+    return G, ptr, lst, y0, axis_of, int_costs, plain
+
+
+@njit(cache=True)
+def evaluate(G, pa, pb, c, relaxed, off_a, off_b, y, na, nb, plain, r, yfull, chosen):
+    """``L(y)`` of the relaxation that keeps axes ``a, b`` (``y`` is 0 on their rows).
+
+    Fills ``r`` (reduced costs w.r.t. the relaxed multipliers), ``yfull`` (``y`` on the
+    relaxed rows, the LAP duals on the kept rows) and ``chosen`` (1 for the
+    candidates of the relaxed solution).  Returns ``(ok, L)``; ``ok`` False: the kept
+    axes alone admit no assignment, so the problem is infeasible.
+    """
+    K = c.shape[0]
+    W = nb + 1
+    Cm = np.full((na + 1) * W, INF)
+    Am = np.full((na + 1) * W, -1)
+    neg = 0.0
+    for k in range(K):
+        rk = c[k]
+        for t in range(relaxed.shape[0]):
+            e = G[k, relaxed[t]]
+            if e >= 0:
+                rk -= y[e]
+        r[k] = rk
+        chosen[k] = 0
+        q = pa[k] * W + pb[k]
+        if q == 0:                       # dummy on both kept axes: free to take
+            if rk < 0.0:
+                neg += rk
+                chosen[k] = 1
+        elif rk < Cm[q]:
+            Cm[q] = rk
+            Am[q] = k
+    S = na if plain else na + nb
+    A = np.full((S, S), INF)
+    for i in range(na):
+        for j in range(nb):
+            A[i, j] = Cm[(i + 1) * W + j + 1]
+    if not plain:                        # misses: private dummy column / row each
+        for i in range(na):
+            A[i, nb + i] = Cm[(i + 1) * W]
+        for j in range(nb):
+            A[na + j, j] = Cm[j + 1]
+            for i in range(na):
+                A[na + j, nb + i] = 0.0
+    ok, col, u, v, cost = hungarian(A)
+    if not ok:
+        return False, -INF
+    yfull[:] = y
+    for i in range(na):
+        yfull[off_a + i] = u[i] if plain else u[i] + v[nb + i]
+        j = col[i]
+        k = Am[(i + 1) * W + j + 1] if j < nb else Am[(i + 1) * W]
+        chosen[k] = 1
+    for j in range(nb):
+        # in the augmented matrix v[nb+i] + u[na+j] <= 0, so y_a[i] + y_b[j] <= C[i, j]
+        yfull[off_b + j] = v[j] if plain else v[j] + u[na + j]
+        if not plain and col[na + j] < nb:
+            chosen[Am[col[na + j] + 1]] = 1
+    return True, y.sum() + cost + neg
+
+
+@njit(cache=True)
+def improve_limit(ub, int_costs, tol):
+    """Bounds at or above this cannot lead to a solution better than ``ub``."""
+    if ub == INF:
+        return INF
+    if int_costs:
+        return ub - 1.0 + max(1e-6, tol * abs(ub))
+    return ub - tol * max(1.0, abs(ub))
+
+
+@njit(cache=True)
+def reduced(G, c, yfull, rp):
+    """``rp = max(r, 0)`` for the full dual ``yfull``; returns ``base``."""
+    K, N = G.shape
+    neg = 0.0
+    for k in range(K):
+        rk = c[k]
+        for s in range(N):
+            e = G[k, s]
+            if e >= 0:
+                rk -= yfull[e]
+        if rk < 0.0:
+            neg += rk
+            rk = 0.0
+        rp[k] = rk
+    return yfull.sum() + neg
+
+
+@njit(cache=True)
+def sort_lists(ptr, lst, rp):
+    """Each row's candidate list sorted by ``rp`` (stable: deterministic)."""
+    out = lst.copy()
+    for e in range(ptr.shape[0] - 1):
+        seg = lst[ptr[e]:ptr[e + 1]]
+        order = np.argsort(rp[seg], kind="mergesort")
+        out[ptr[e]:ptr[e + 1]] = seg[order]
+    return out
+
+
+@njit(cache=True)
+def _free(G, k, covered):
+    for s in range(G.shape[1]):
+        e = G[k, s]
+        if e >= 0 and covered[e]:
+            return False
+    return True
+
+
+@njit(cache=True)
+def _select(G, rp, ptr, lst, axis_of, covered, slack, rem):
+    """Branching row: the uncovered row with the fewest live candidates (Knuth's
+    rule).  ``slack`` = limit - base - acc.  Returns ``(row, bound)``; row -1: some
+    row has no live candidate (dead node).  ``bound`` = max over axes of the sum of
+    each uncovered row's least live reduced cost (one candidate per row per axis)."""
+    rem[:] = 0.0
+    best_e = -1
+    best_cnt = 1 << 60
+    for e in range(ptr.shape[0] - 1):
+        if covered[e]:
+            continue
+        cnt = 0
+        first = 0.0
+        for p in range(ptr[e], ptr[e + 1]):
+            k = lst[p]
+            if rp[k] >= slack:
+                break
+            if _free(G, k, covered):
+                if cnt == 0:
+                    first = rp[k]
+                cnt += 1
+                if cnt >= best_cnt:
+                    break
+        if cnt == 0:
+            return -1, INF
+        rem[axis_of[e]] += first
+        if cnt < best_cnt:
+            best_cnt = cnt
+            best_e = e
+    return best_e, rem.max()
+
+
+@njit(cache=True)
+def dfs(G, c, rp, base, ptr, lst, axis_of, n_axes, int_costs, tol, ub, best_sel,
+        best_len, budget):
+    """Depth-first exact-cover search for a solution cheaper than ``ub``.
+
+    Candidates are tried cheapest reduced cost first; a node is cut when
+    ``base + acc + bound`` reaches the improvement limit.  Returns ``(outcome, ub,
+    best_len, nodes)``; ``best_sel[:best_len]`` holds the incumbent.  ``COMPLETE``
+    means no solution cheaper than the returned ``ub`` exists.
+    """
+    E = ptr.shape[0] - 1
+    covered = np.zeros(E, np.bool_)
+    rem = np.zeros(n_axes)
+    stack_e = np.empty(E + 1, np.int64)
+    stack_p = np.empty(E + 1, np.int64)
+    stack_k = np.full(E + 1, -1, np.int64)
+    limit = improve_limit(ub, int_costs, tol)
+    nodes = 0
+    ncov = 0
+    acc = 0.0
+    e0, bnd = _select(G, rp, ptr, lst, axis_of, covered, limit - base, rem)
+    if e0 < 0 or base + bnd >= limit:
+        return COMPLETE, ub, best_len, nodes
+    d = 0
+    stack_e[0] = e0
+    stack_p[0] = ptr[e0]
+    stack_k[0] = -1
+    while d >= 0:
+        k = stack_k[d]
+        if k >= 0:                                  # undo the last choice here
+            for s in range(n_axes):
+                e = G[k, s]
+                if e >= 0:
+                    covered[e] = False
+                    ncov -= 1
+            acc -= rp[k]
+            stack_k[d] = -1
+        e = stack_e[d]
+        p = stack_p[d]
+        found = -1
+        slack = limit - base - acc
+        while p < ptr[e + 1]:
+            k = lst[p]
+            p += 1
+            if rp[k] >= slack:
+                p = ptr[e + 1]
+                break
+            if _free(G, k, covered):
+                found = k
+                break
+        stack_p[d] = p
+        if found < 0:
+            d -= 1
+            continue
+        for s in range(n_axes):
+            e = G[found, s]
+            if e >= 0:
+                covered[e] = True
+                ncov += 1
+        acc += rp[found]
+        stack_k[d] = found
+        nodes += 1
+        if ncov == E:                               # leaf: an exact cover
+            cost = 0.0
+            for t in range(d + 1):
+                cost += c[stack_k[t]]
+            if ub == INF or cost < ub - 1e-12 * max(1.0, abs(ub)):
+                ub = cost
+                best_sel[:d + 1] = stack_k[:d + 1]
+                best_len = d + 1
+                limit = improve_limit(ub, int_costs, tol)
+            continue
+        if nodes >= budget:
+            return BUDGET, ub, best_len, nodes
+        e2, bnd = _select(G, rp, ptr, lst, axis_of, covered, limit - base - acc, rem)
+        if e2 < 0 or base + acc + bnd >= limit:
+            continue
+        d += 1
+        stack_e[d] = e2
+        stack_p[d] = ptr[e2]
+        stack_k[d] = -1
+    return COMPLETE, ub, best_len, nodes
+
+
+# solve() outcomes
+PROVEN = 0         # incumbent optimal (or infeasible if there is none)
+STOPPED = 1        # budget spent: incumbent (if any) and a bound
+INFEASIBLE = 2     # the kept axes admit no assignment
+
+
+@njit(cache=True)
+def solve(G, pa, pb, c, relaxed, a, b, off_a, off_b, na, nb, plain, axis_of, ptr, lst,
+          int_costs, tol, y0, max_iter, probe_every, probe_budget, budget,
+          lam0, patience, lam_min):
+    """Subgradient ascent on ``L(y)`` with periodic DFS probes, then a final DFS.
+
+    Returns ``(outcome, best_sel, best_len, ub, bound, iterations, nodes)``.
+    """
+    K, N = G.shape
+    E = ptr.shape[0] - 1
+    y = y0.copy()
+    r = np.empty(K)
+    rp = np.empty(K)
+    yfull = np.zeros(E)
+    ybest = np.zeros(E)
+    chosen = np.zeros(K, np.int8)
+    g = np.zeros(E)
+    best_sel = np.full(E + 1, -1, np.int64)
+    best_len = -1
+    ub = INF
+    best_L = -INF
+    lam = lam0
+    since = 0
+    nodes = 0
+    it = 0
+    for it in range(1, max_iter + 1):
+        ok, L = evaluate(G, pa, pb, c, relaxed, off_a, off_b, y, na, nb, plain, r,
+                         yfull, chosen)
+        if not ok:
+            return INFEASIBLE, best_sel, best_len, ub, INF, it, nodes
+        g[:] = 0.0
+        for t in range(relaxed.shape[0]):
+            s = relaxed[t]
+            for k in range(K):
+                e = G[k, s]
+                if chosen[k] and e >= 0:
+                    g[e] -= 1.0
+        norm2 = 0.0
+        for e in range(E):
+            if axis_of[e] != a and axis_of[e] != b:
+                g[e] += 1.0
+                norm2 += g[e] * g[e]
+        if L > best_L:
+            best_L = L
+            ybest[:] = yfull
+            since = 0
+        else:
+            since += 1
+            if since >= patience:
+                lam *= 0.5
+                since = 0
+        if norm2 == 0.0:                  # relaxed solution covers every row once
+            cost = 0.0
+            n = 0
+            for k in range(K):
+                if chosen[k]:
+                    best_sel[n] = k
+                    n += 1
+                    cost += c[k]
+            if cost < ub:
+                ub = cost
+                best_len = n
+            return PROVEN, best_sel, best_len, ub, max(best_L, cost), it, nodes
+        if best_L >= improve_limit(ub, int_costs, tol):
+            return PROVEN, best_sel, best_len, ub, best_L, it, nodes
+        if probe_every > 0 and (it - 1) % probe_every == 0:
+            base = reduced(G, c, ybest, rp)
+            slst = sort_lists(ptr, lst, rp)
+            out, ub, best_len, nn = dfs(G, c, rp, base, ptr, slst, axis_of, N,
+                                        int_costs, tol, ub, best_sel, best_len,
+                                        probe_budget)
+            nodes += nn
+            if out == COMPLETE:
+                return PROVEN, best_sel, best_len, ub, best_L, it, nodes
+        if lam < lam_min:
+            break
+        target = ub if ub < INF else best_L + 0.05 * max(abs(best_L), 1.0)
+        step = lam * (target - L) / norm2
+        for e in range(E):
+            y[e] += step * g[e]
+    base = reduced(G, c, ybest, rp)
+    slst = sort_lists(ptr, lst, rp)
+    out, ub, best_len, nn = dfs(G, c, rp, base, ptr, slst, axis_of, N, int_costs, tol,
+                                ub, best_sel, best_len, budget)
+    nodes += nn
+    if out == COMPLETE:
+        return PROVEN, best_sel, best_len, ub, best_L, it, nodes
+    return STOPPED, best_sel, best_len, ub, best_L, it, nodes
