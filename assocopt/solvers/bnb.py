@@ -6,31 +6,42 @@ runs everything in one compiled call (numba, :mod:`assocopt.solvers.bnb_kernels`
 
 1. *Ascent.*  The Lagrangian relaxation of :mod:`assocopt.solvers.lagrangian`: keep
    two axes, price the others with multipliers ``y``, solve the 2-D assignment with
-   misses by a dense Hungarian method, take a Polyak subgradient step.
+   misses by a dense Hungarian method, take a deflected Polyak subgradient step
+   towards the incumbent.  For N = 3 every iteration also recovers a feasible
+   solution (Pattipati et al. 1992): keep the relaxed solution's pairs and attach the
+   third axis by one more 2-D assignment with misses.
 2. *Reduced costs.*  The multipliers plus the Hungarian duals give a dual ``y`` on
-   every real index; ``r[k] = c[k] - sum_{e in k} y[e]`` and
-   ``base = sum(y) + sum_k min(r[k], 0)``.  Every exact cover ``X`` costs at least
-   ``base + sum_{k in X} max(r[k], 0)``, whatever ``y`` is, so the bound is valid by
-   construction and the ascent only tightens it.
+   every real index, raised greedily where a row's candidates all have slack;
+   ``r[k] = c[k] - sum_{e in k} y[e]`` and ``base = sum(y) + sum_k min(r[k], 0)``.
+   Every exact cover ``X`` costs at least ``base + sum_{k in X} max(r[k], 0)``,
+   whatever ``y`` is, so the bound is valid by construction and the ascent only
+   tightens it.  Candidates whose reduced cost alone reaches the incumbent are
+   dropped (reduced-cost fixing).
 3. *Branch and bound.*  Depth-first exact-cover search: branch on the uncovered
    index with the fewest live candidates, cheapest reduced cost first; cut a node when
    ``base + acc + max_s sum_{uncovered e on axis s} min live r`` reaches the
    incumbent (integer costs: the incumbent minus one).  Short searches run during
-   the ascent as well: they find incumbents for the step rule and often finish the
-   proof early.  A search that completes proves the incumbent optimal.
+   the ascent as well and often finish the proof early.  A search that completes
+   proves the incumbent optimal.
 
 The search stops after ``max_nodes`` nodes; then, with ``fallback=True`` (default),
 the problem goes to ``lagrangian-exact`` with what is left of ``time_limit``, so the
-answer is still a proven optimum.  ``solver="auto"`` uses this back end for small
-N >= 3 problems (see :func:`assocopt.api.choose_solver`).
+answer is still a proven optimum.  Problems whose kept-axes matrix
+``(n_a+1)(n_b+1)`` exceeds :data:`MAX_DENSE` entries go there directly (the kernels
+use dense 2-D matrices).  The compiled part does not check the clock: ``time_limit``
+applies to the fallback.  ``solver="auto"`` uses this back end for small N >= 3
+problems (see :func:`assocopt.api.choose_solver`).
 
 Options (all recorded in ``info["parameters"]``): ``max_iter`` (100) subgradient
-iterations; ``probe_every`` (10) iterations between short searches (0: none);
-``probe_nodes`` (None: 20 per real index + 200) nodes per short search;
-``max_nodes`` (200,000) nodes of the final search; ``step0`` (2.0), ``patience``
-(5), ``step_min`` (1e-3): Polyak step scale, halved after ``patience`` iterations
-without a better bound, the ascent ends below ``step_min``; ``keep_axes`` (None: the
-two largest axes); ``fallback`` (True).
+iterations; ``probe_every`` (15) iterations between short searches (0: none);
+``probe_nodes`` (200) nodes per short search; ``max_nodes`` (200,000) nodes of the
+final search; ``step0`` (2.0), ``patience`` (10), ``step_min`` (1e-3): Polyak step
+scale, halved after ``patience`` iterations without a better bound, the ascent ends
+below ``step_min``; ``deflect`` (0.5): share of the previous direction kept;
+``recover_every`` (1): N = 3 primal recovery every k iterations (0: never);
+``keep_axes`` (None: the two largest axes); ``fallback`` (True).  The defaults were
+tuned on paper-002 problems and random 3-AP with n <= 10
+(``benchmarks/sd_scaling.py``).
 
 Examples
 --------
@@ -44,13 +55,14 @@ Examples
 
 from __future__ import annotations
 
+import math
 import time
 from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
 
-from ..errors import InvalidProblemError
+from ..errors import InvalidProblemError, ProblemTooLargeError
 from ..problem import AssignmentProblem
 from ..solution import Status
 from .base import Backend, RawResult, SolveOptions, register, get_backend
@@ -61,9 +73,14 @@ __all__ = ["BranchBoundBackend", "DEFAULTS", "BnbInput"]
 #: the same as the Lagrangian back ends' ``OPT_TOL``.
 TOL = 1e-9
 
+#: Largest dense matrix (entries) the kernels allocate: ``(n_a+1)(n_b+1)`` for the
+#: 2-D subproblem, ``(n_a+1)(n_b+1)(n_c+1)`` for the N = 3 recovery lookup.
+MAX_DENSE = 4_000_000
+
 DEFAULTS: dict[str, Any] = {
-    "max_iter": 100, "probe_every": 10, "probe_nodes": None, "max_nodes": 200_000,
-    "step0": 2.0, "patience": 5, "step_min": 1e-3, "keep_axes": None, "fallback": True,
+    "max_iter": 100, "probe_every": 15, "probe_nodes": 200, "max_nodes": 200_000,
+    "step0": 2.0, "patience": 10, "step_min": 1e-3, "keep_axes": None, "fallback": True,
+    "deflect": 0.5, "recover_every": 1,
 }
 
 
@@ -122,7 +139,8 @@ def _parse(extra: dict[str, Any]) -> dict[str, Any]:
         raise InvalidProblemError(f"unknown option(s) for solver 'bnb': {sorted(unknown)}; "
                                   f"valid: {sorted(DEFAULTS)}")
     p = dict(DEFAULTS, **extra)
-    for key in ("max_iter", "probe_every", "max_nodes", "patience"):
+    for key in ("max_iter", "probe_every", "probe_nodes", "max_nodes", "patience",
+                "recover_every"):
         if int(p[key]) < 0 or (key in ("max_nodes", "patience") and int(p[key]) < 1):
             raise InvalidProblemError(f"option {key} must be a positive integer, "
                                       f"got {p[key]!r}")
@@ -131,6 +149,10 @@ def _parse(extra: dict[str, Any]) -> dict[str, Any]:
         p[key] = float(p[key])
         if not p[key] > 0:
             raise InvalidProblemError(f"option {key} must be positive, got {p[key]!r}")
+    p["deflect"] = float(p["deflect"])
+    if not 0.0 <= p["deflect"] < 1.0:
+        raise InvalidProblemError(f"option deflect must be in [0, 1), got {p['deflect']!r}")
+    p["fallback"] = bool(p["fallback"])
     return p
 
 
@@ -154,19 +176,31 @@ class BranchBoundBackend(Backend):
 
         inp = BnbInput.build(problem, p["keep_axes"])
         na, nb = problem.sizes[inp.a], problem.sizes[inp.b]
-        E = len(inp.axis_of)
-        probe_nodes = (20 * E + 200 if p["probe_nodes"] is None else int(p["probe_nodes"]))
+        probe_nodes = p["probe_nodes"]
+        if (na + 1) * (nb + 1) > MAX_DENSE:
+            info = {"parameters": dict(p), "reason": f"(n_a+1)(n_b+1) = "
+                    f"{(na + 1) * (nb + 1)} > MAX_DENSE = {MAX_DENSE}"}
+            if not p["fallback"]:
+                raise ProblemTooLargeError(
+                    f"solver 'bnb' uses dense matrices of (n_a+1)(n_b+1) = "
+                    f"{(na + 1) * (nb + 1)} entries, more than {MAX_DENSE}; use "
+                    "'lagrangian-exact' or fallback=True")
+            return self._fallback(problem, options, info, t0)
         T = problem.tuples
+        # N = 3: primal recovery through a dense (n_a+1)(n_b+1)(n_c+1) tuple lookup
+        n3 = problem.ndim == 3 and math.prod(s + 1 for s in problem.sizes) <= MAX_DENSE
+        c_axis = int(inp.relaxed[0]) if len(inp.relaxed) == 1 else 0
+        off_c, n_c = int(inp.off[c_axis]), int(problem.sizes[c_axis])
         t_build = time.perf_counter() - t0
         out, sel, n_sel, ub, bound, iters, nodes = kern.solve(
             inp.G, T[:, inp.a].copy(), T[:, inp.b].copy(), inp.c, inp.relaxed,
             inp.a, inp.b, int(inp.off[inp.a]), int(inp.off[inp.b]), na, nb, inp.plain,
             inp.axis_of, inp.ptr, inp.lst, inp.int_costs, TOL, inp.y0, p["max_iter"],
             p["probe_every"], probe_nodes, p["max_nodes"], p["step0"], p["patience"],
-            p["step_min"])
+            p["step_min"], p["deflect"], p["recover_every"], n3, off_c, n_c)
         dt = time.perf_counter() - t0
         params = {k: v for k, v in p.items()}
-        params.update(keep_axes=[inp.a, inp.b], probe_nodes=probe_nodes, tol=TOL)
+        params.update(keep_axes=[inp.a, inp.b], tol=TOL)
         info: dict[str, Any] = {"iterations": int(iters), "nodes": int(nodes),
                                 "lagrangian_bound": float(bound), "parameters": params,
                                 "integer_costs": inp.int_costs}
@@ -191,14 +225,15 @@ class BranchBoundBackend(Backend):
     @staticmethod
     def _fallback(problem: AssignmentProblem, options: SolveOptions,
                   info: dict[str, Any], t0: float) -> RawResult:
-        """Node budget spent: hand the problem to ``lagrangian-exact``."""
+        """Node budget spent (or the problem too large): ``lagrangian-exact``."""
         left = None
         if options.time_limit is not None:
-            left = max(options.time_limit - (time.perf_counter() - t0), 0.0)
+            left = max(options.time_limit - (time.perf_counter() - t0), 1e-3)
         sub = SolveOptions(time_limit=left, mip_gap=options.mip_gap,
                            threads=options.threads, verbose=options.verbose)
         raw = get_backend("lagrangian-exact")().solve(problem, sub)
         raw.info = dict(raw.info, bnb=info)
-        raw.message = f"bnb node budget spent, then {raw.message}"
+        why = info.get("reason", "node budget spent")
+        raw.message = f"bnb: {why}, then {raw.message}"
         raw.solve_time = time.perf_counter() - t0 - raw.build_time
         return raw

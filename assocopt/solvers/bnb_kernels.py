@@ -219,8 +219,8 @@ def improve_limit(ub, int_costs, tol):
 
 
 @njit(cache=True)
-def reduced(G, c, yfull, rp):
-    """``rp = max(r, 0)`` for the full dual ``yfull``; returns ``base``."""
+def full_reduced(G, c, yfull, r):
+    """``r = c - sum of yfull over each candidate's rows``; returns ``sum_k min(r, 0)``."""
     K, N = G.shape
     neg = 0.0
     for k in range(K):
@@ -229,22 +229,69 @@ def reduced(G, c, yfull, rp):
             e = G[k, s]
             if e >= 0:
                 rk -= yfull[e]
+        r[k] = rk
         if rk < 0.0:
             neg += rk
-            rk = 0.0
-        rp[k] = rk
+    return neg
+
+
+@njit(cache=True)
+def raise_rows(ptr, lst, axis_of, skip_a, skip_b, yfull, r):
+    """Greedy dual ascent: raise each row's dual by its least reduced cost when all
+    its candidates have ``r >= 0`` (the bound grows by exactly that amount and every
+    ``r`` stays >= 0).  Rows of axes ``skip_a, skip_b`` are left alone (-1: none)."""
+    gain = 0.0
+    for e in range(ptr.shape[0] - 1):
+        s = axis_of[e]
+        if s == skip_a or s == skip_b:
+            continue
+        m = INF
+        for p in range(ptr[e], ptr[e + 1]):
+            v = r[lst[p]]
+            if v < m:
+                m = v
+        if m > 0.0 and m < INF:
+            yfull[e] += m
+            gain += m
+            for p in range(ptr[e], ptr[e + 1]):
+                r[lst[p]] -= m
+    return gain
+
+
+@njit(cache=True)
+def reduced(G, c, yfull, rp, ptr, lst, axis_of):
+    """Raise ``yfull`` on every row (in place), then ``rp = max(r, 0)``; returns
+    ``base = sum(yfull) + sum_k min(r, 0)``."""
+    neg = full_reduced(G, c, yfull, rp)
+    raise_rows(ptr, lst, axis_of, -1, -1, yfull, rp)
+    for k in range(rp.shape[0]):
+        if rp[k] < 0.0:
+            rp[k] = 0.0
     return yfull.sum() + neg
 
 
 @njit(cache=True)
-def sort_lists(ptr, lst, rp):
-    """Each row's candidate list sorted by ``rp`` (stable: deterministic)."""
-    out = lst.copy()
-    for e in range(ptr.shape[0] - 1):
-        seg = lst[ptr[e]:ptr[e + 1]]
-        order = np.argsort(rp[seg], kind="mergesort")
-        out[ptr[e]:ptr[e + 1]] = seg[order]
-    return out
+def sort_lists(ptr, lst, rp, slack):
+    """Each row's candidates with ``rp < slack`` (reduced-cost fixing: the others
+    cannot be in a solution better than the incumbent), sorted by ``rp`` (stable:
+    deterministic).  Returns the new ``(ptr, lst)``."""
+    E = ptr.shape[0] - 1
+    ptr2 = np.zeros(E + 1, np.int64)
+    out = np.empty(lst.shape[0], np.int64)
+    n = 0
+    for e in range(E):
+        start = n
+        for p in range(ptr[e], ptr[e + 1]):
+            k = lst[p]
+            if rp[k] < slack:
+                out[n] = k
+                n += 1
+        if n - start > 1:
+            seg = out[start:n].copy()
+            order = np.argsort(rp[seg], kind="mergesort")
+            out[start:n] = seg[order]
+        ptr2[e + 1] = n
+    return ptr2, out[:n]
 
 
 @njit(cache=True)
@@ -373,6 +420,74 @@ def dfs(G, c, rp, base, ptr, lst, axis_of, n_axes, int_costs, tol, ub, best_sel,
     return COMPLETE, ub, best_len, nodes
 
 
+@njit(cache=True)
+def tuple_index(G, pa, pb, pc, na, nb, nc):
+    """Dense lookup ``(i_a, i_b, i_c) -> candidate`` for N = 3 (-1: none)."""
+    idx = np.full((na + 1) * (nb + 1) * (nc + 1), -1, np.int64)
+    for k in range(pa.shape[0]):
+        idx[(pa[k] * (nb + 1) + pb[k]) * (nc + 1) + pc[k]] = k
+    return idx
+
+
+@njit(cache=True)
+def recover3(c, pa, pb, chosen, idx, nb, nc, sel):
+    """Primal recovery for N = 3 (Pattipati et al.): keep the relaxed solution's
+    kept-axes pairs, attach the third axis by a 2-D assignment with misses (pair
+    alone, or the index alone).  Fills ``sel``; returns ``(n, cost)``, ``n = -1`` if
+    that assignment is infeasible."""
+    W = nc + 1
+    npair = 0
+    base_of = np.empty(chosen.shape[0], np.int64)
+    for k in range(chosen.shape[0]):
+        if chosen[k] and (pa[k] > 0 or pb[k] > 0):
+            base_of[npair] = (pa[k] * (nb + 1) + pb[k]) * W
+            npair += 1
+    plain = True
+    for g in range(npair):
+        if idx[base_of[g]] >= 0:
+            plain = False
+            break
+    if plain:
+        for t in range(1, nc + 1):
+            if idx[t] >= 0:
+                plain = False
+                break
+    if plain and npair != nc:
+        return -1, INF
+    S = nc if plain else npair + nc
+    A = np.full((S, S), INF)
+    for g in range(npair):
+        for t in range(nc):
+            k = idx[base_of[g] + t + 1]
+            if k >= 0:
+                A[g, t] = c[k]
+    if not plain:
+        for g in range(npair):
+            k = idx[base_of[g]]
+            if k >= 0:
+                A[g, nc + g] = c[k]
+        for t in range(nc):
+            k = idx[t + 1]
+            if k >= 0:
+                A[npair + t, t] = c[k]
+            for g in range(npair):
+                A[npair + t, nc + g] = 0.0
+    ok, col, u, v, cost = hungarian(A)
+    if not ok:
+        return -1, INF
+    n = 0
+    for g in range(npair):
+        t = col[g]
+        sel[n] = idx[base_of[g] + t + 1] if t < nc else idx[base_of[g]]
+        n += 1
+    if not plain:
+        for t in range(nc):
+            if col[npair + t] < nc:
+                sel[n] = idx[col[npair + t] + 1]
+                n += 1
+    return n, cost
+
+
 # solve() outcomes
 PROVEN = 0         # incumbent optimal (or infeasible if there is none)
 STOPPED = 1        # budget spent: incumbent (if any) and a bound
@@ -382,7 +497,7 @@ INFEASIBLE = 2     # the kept axes admit no assignment
 @njit(cache=True)
 def solve(G, pa, pb, c, relaxed, a, b, off_a, off_b, na, nb, plain, axis_of, ptr, lst,
           int_costs, tol, y0, max_iter, probe_every, probe_budget, budget,
-          lam0, patience, lam_min):
+          lam0, patience, lam_min, deflect, recover_every, n3, off_c, n_c):
     """Subgradient ascent on ``L(y)`` with periodic DFS probes, then a final DFS.
 
     Returns ``(outcome, best_sel, best_len, ub, bound, iterations, nodes)``.
@@ -395,7 +510,9 @@ def solve(G, pa, pb, c, relaxed, a, b, off_a, off_b, na, nb, plain, axis_of, ptr
     yfull = np.zeros(E)
     ybest = np.zeros(E)
     chosen = np.zeros(K, np.int8)
+    rfull = np.empty(K)
     g = np.zeros(E)
+    dvec = np.zeros(E)
     best_sel = np.full(E + 1, -1, np.int64)
     best_len = -1
     ub = INF
@@ -404,6 +521,17 @@ def solve(G, pa, pb, c, relaxed, a, b, off_a, off_b, na, nb, plain, axis_of, ptr
     since = 0
     nodes = 0
     it = 0
+    nc = 0
+    if n3:
+        pc = np.zeros(K, np.int64)
+        for k in range(K):
+            e = G[k, relaxed[0]]
+            pc[k] = 0 if e < 0 else e - off_c + 1
+        nc = n_c
+        idx3 = tuple_index(G, pa, pb, pc, na, nb, nc)
+    else:
+        idx3 = np.empty(0, np.int64)
+    tmp_sel = np.empty(E + 1, np.int64)
     for it in range(1, max_iter + 1):
         ok, L = evaluate(G, pa, pb, c, relaxed, off_a, off_b, y, na, nb, plain, r,
                          yfull, chosen)
@@ -421,6 +549,12 @@ def solve(G, pa, pb, c, relaxed, a, b, off_a, off_b, na, nb, plain, axis_of, ptr
             if axis_of[e] != a and axis_of[e] != b:
                 g[e] += 1.0
                 norm2 += g[e] * g[e]
+        # greedy raise of the relaxed rows: a bound >= L(y) at the cost of two passes
+        neg = full_reduced(G, c, yfull, rfull)
+        raise_rows(ptr, lst, axis_of, a, b, yfull, rfull)
+        B = yfull.sum() + neg
+        if B > L:
+            L = B
         if L > best_L:
             best_L = L
             ybest[:] = yfull
@@ -442,12 +576,19 @@ def solve(G, pa, pb, c, relaxed, a, b, off_a, off_b, na, nb, plain, axis_of, ptr
                 ub = cost
                 best_len = n
             return PROVEN, best_sel, best_len, ub, max(best_L, cost), it, nodes
+        if n3 and recover_every > 0 and (it - 1) % recover_every == 0:
+            m, cost = recover3(c, pa, pb, chosen, idx3, nb, nc, tmp_sel)
+            if m > 0 and (ub == INF or cost < ub - 1e-12 * max(1.0, abs(ub))):
+                ub = cost
+                best_sel[:m] = tmp_sel[:m]
+                best_len = m
         if best_L >= improve_limit(ub, int_costs, tol):
             return PROVEN, best_sel, best_len, ub, best_L, it, nodes
         if probe_every > 0 and (it - 1) % probe_every == 0:
-            base = reduced(G, c, ybest, rp)
-            slst = sort_lists(ptr, lst, rp)
-            out, ub, best_len, nn = dfs(G, c, rp, base, ptr, slst, axis_of, N,
+            base = reduced(G, c, ybest, rp, ptr, lst, axis_of)
+            sptr, slst = sort_lists(ptr, lst, rp,
+                                    improve_limit(ub, int_costs, tol) - base)
+            out, ub, best_len, nn = dfs(G, c, rp, base, sptr, slst, axis_of, N,
                                         int_costs, tol, ub, best_sel, best_len,
                                         probe_budget)
             nodes += nn
@@ -456,12 +597,16 @@ def solve(G, pa, pb, c, relaxed, a, b, off_a, off_b, na, nb, plain, axis_of, ptr
         if lam < lam_min:
             break
         target = ub if ub < INF else best_L + 0.05 * max(abs(best_L), 1.0)
-        step = lam * (target - L) / norm2
+        nd2 = 0.0
+        for e in range(E):                # deflected direction (Camerini et al.)
+            dvec[e] = g[e] + deflect * dvec[e]
+            nd2 += dvec[e] * dvec[e]
+        step = lam * (target - L) / nd2
         for e in range(E):
-            y[e] += step * g[e]
-    base = reduced(G, c, ybest, rp)
-    slst = sort_lists(ptr, lst, rp)
-    out, ub, best_len, nn = dfs(G, c, rp, base, ptr, slst, axis_of, N, int_costs, tol,
+            y[e] += step * dvec[e]
+    base = reduced(G, c, ybest, rp, ptr, lst, axis_of)
+    sptr, slst = sort_lists(ptr, lst, rp, improve_limit(ub, int_costs, tol) - base)
+    out, ub, best_len, nn = dfs(G, c, rp, base, sptr, slst, axis_of, N, int_costs, tol,
                                 ub, best_sel, best_len, budget)
     nodes += nn
     if out == COMPLETE:
