@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import functools
 import math
 import time
 from typing import Any
@@ -14,18 +15,39 @@ from .problem import AssignmentProblem, index_label
 from .solution import Solution, Status
 from .solvers.base import Backend, RawResult, SolveOptions, get_backend
 
-__all__ = ["solve", "choose_solver"]
+__all__ = ["solve", "choose_solver", "BNB_MAX_CANDIDATES"]
+
+
+#: ``auto`` sends N >= 3 problems with at most this many candidates to ``bnb``
+#: (compiled branch and bound) when numba is installed; measured faster than
+#: ``lagrangian-exact`` up to Grundel n = 20 (8,000 candidates), slower at n = 30
+#: (docs/benchmarks-sd.md).
+BNB_MAX_CANDIDATES = 10_000
 
 
 def choose_solver(problem: AssignmentProblem, relax: str | None = None) -> str:
-    """The back end ``solver="auto"`` picks: the 2-D fast path, the Lagrangian exact
-    method for S-D (N >= 3; measured fastest from n = 3 upwards, see
-    docs/benchmarks-sd.md), or HiGHS for LP relaxations."""
-    if relax is None and problem.ndim == 2:
+    """The back end ``solver="auto"`` picks, by size and structure (measured in
+    docs/benchmarks-sd.md): the 2-D fast path; for S-D (N >= 3) the compiled branch
+    and bound ``bnb`` up to :data:`BNB_MAX_CANDIDATES` candidates (numba installed),
+    else the Lagrangian exact method; HiGHS for LP relaxations."""
+    if relax is not None:
+        return "highs"
+    if problem.ndim == 2:
         return "scipy-lsa"
-    if relax is None:
-        return "lagrangian-exact"
-    return "highs"
+    if problem.n_candidates <= BNB_MAX_CANDIDATES and _bnb_usable(problem):
+        return "bnb"
+    return "lagrangian-exact"
+
+
+def _bnb_usable(problem: AssignmentProblem) -> bool:
+    from .solvers.bnb import MAX_DENSE, dense_size
+    return _numba_installed() and dense_size(problem) <= MAX_DENSE
+
+
+@functools.lru_cache(maxsize=None)
+def _numba_installed() -> bool:
+    """Cached: looking a package up costs tens of microseconds, a small solve ~300."""
+    return get_backend("bnb").is_available()
 
 
 def solve(problem: AssignmentProblem, solver: str = "auto", *, relax: str | None = None,

@@ -268,12 +268,16 @@ def test_parameters_are_recorded():
     assert {"max_iter", "gap_tol", "patience", "window_solver"} <= set(par)
 
 
-def test_auto_picks_lagrangian_exact_for_three_or_more_axes():
-    assert choose_solver(_rand3(3)) == "lagrangian-exact"
+def test_auto_picks_lagrangian_exact_for_large_three_or_more_axes(monkeypatch):
+    import assocopt.api as api
+    monkeypatch.setattr(api, "BNB_MAX_CANDIDATES", 10)
+    assert choose_solver(_rand3(3)) == "lagrangian-exact"       # 27 candidates
     assert choose_solver(AssignmentProblem.dense(np.ones((3, 3)))) == "scipy-lsa"
     assert choose_solver(_rand3(3), relax="lp") == "highs"
     p = _rand3(5, seed=9)
-    assert_optimal(p, solve(p))
+    sol = solve(p)
+    assert sol.solver == "lagrangian-exact"
+    assert_optimal(p, sol)
 
 
 # ------------------------------------------------------------------- 2-D helpers

@@ -67,7 +67,7 @@ from ..problem import AssignmentProblem
 from ..solution import Status
 from .base import Backend, RawResult, SolveOptions, register, get_backend
 
-__all__ = ["BranchBoundBackend", "DEFAULTS", "BnbInput"]
+__all__ = ["BranchBoundBackend", "DEFAULTS", "BnbInput", "MAX_DENSE", "dense_size"]
 
 #: Relative tolerance of "bound meets objective" for non-integer costs (round-off),
 #: the same as the Lagrangian back ends' ``OPT_TOL``.
@@ -82,6 +82,12 @@ DEFAULTS: dict[str, Any] = {
     "step0": 2.0, "patience": 10, "step_min": 1e-3, "keep_axes": None, "fallback": True,
     "deflect": 0.5, "recover_every": 1,
 }
+
+
+def dense_size(problem: AssignmentProblem, keep_axes: Any = None) -> int:
+    """Entries of the kernels' 2-D matrix ``(n_a+1)(n_b+1)`` for the kept axes."""
+    a, b = _keep(problem.sizes, keep_axes)
+    return (problem.sizes[a] + 1) * (problem.sizes[b] + 1)
 
 
 @dataclass(frozen=True)

@@ -601,6 +601,10 @@ def solve(G, pa, pb, c, relaxed, a, b, off_a, off_b, na, nb, plain, axis_of, ptr
         for e in range(E):                # deflected direction (Camerini et al.)
             dvec[e] = g[e] + deflect * dvec[e]
             nd2 += dvec[e] * dvec[e]
+        if nd2 <= 0.0:                    # the deflection cancelled g: restart from g
+            for e in range(E):
+                dvec[e] = g[e]
+            nd2 = norm2
         step = lam * (target - L) / nd2
         for e in range(E):
             y[e] += step * dvec[e]

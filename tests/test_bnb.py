@@ -1,0 +1,189 @@
+"""The compiled branch and bound back end ``bnb`` and its kernels.
+
+Exactness on random S-D problems (N = 3..5, with and without dummies, integer and
+float costs) against brute force; every path out of the kernel (proof during the
+ascent, by a probe, by the final search, node budget with and without fallback,
+too large for dense matrices, infeasible); the Hungarian kernel against scipy; the
+``auto`` choice.  The generic conformance suite (tests/test_conformance.py) and the
+known optima (tests/test_known_optima.py) run ``bnb`` as well.  No timing asserts.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
+from scipy.optimize import linear_sum_assignment
+
+from assocopt import (AssignmentProblem, InvalidProblemError, ProblemTooLargeError,
+                      Status, choose_solver, solve)
+from assocopt.testing import assert_feasible, assert_optimal, random_problem
+
+pytest.importorskip("numba", reason="the bnb back end needs numba")
+
+from assocopt.solvers import bnb  # noqa: E402
+from assocopt.solvers import bnb_kernels as kern  # noqa: E402
+
+
+def _sd(rng: np.random.Generator, N: int, dummies: bool, integer: bool) -> AssignmentProblem:
+    if dummies:
+        hi = {3: 4, 4: 3, 5: 3}[N]
+        sizes = tuple(int(v) for v in rng.integers(1, hi, size=N))
+        return random_problem(rng, "sd", sizes=sizes, integer=integer,
+                              keep=float(rng.choice([0.3, 0.6, 1.0])))
+    n = int(rng.integers(1, {3: 5, 4: 4, 5: 3}[N]))
+    C = rng.integers(-5, 20, size=(n,) * N).astype(float) if integer else rng.normal(
+        size=(n,) * N)
+    return AssignmentProblem.dense(C)
+
+
+@st.composite
+def sd_problems(draw):
+    N = draw(st.integers(3, 5))
+    rng = np.random.default_rng(draw(st.integers(0, 2 ** 32 - 1)))
+    return _sd(rng, N, draw(st.booleans()), draw(st.booleans()))
+
+
+@given(sd_problems())
+def test_equals_brute_force(p):
+    assert_optimal(p, solve(p, "bnb"))
+
+
+@settings(max_examples=40)
+@given(sd_problems(), st.sampled_from([
+    {"probe_every": 0}, {"recover_every": 0}, {"max_iter": 0}, {"max_iter": 1},
+    {"deflect": 0.0, "patience": 1}, {"keep_axes": (0, 2)}, {"probe_nodes": 1},
+]))
+def test_every_option_setting_stays_exact(p, opts):
+    sol = solve(p, "bnb", **opts)
+    assert_optimal(p, sol)
+    assert "bnb" not in sol.info          # proven by the kernel, not the fallback
+
+
+@settings(max_examples=30)
+@given(sd_problems())
+def test_node_budget_without_fallback_gives_valid_bound(p):
+    ref = solve(p, "bruteforce")
+    sol = solve(p, "bnb", max_nodes=1, probe_every=0, max_iter=1, recover_every=0,
+                fallback=False)
+    if sol.status is Status.OPTIMAL:
+        assert_optimal(p, sol)
+        return
+    assert sol.status is Status.TIME_LIMIT, sol.message
+    if sol.bound is not None:
+        assert sol.bound <= ref.objective + 1e-9 * max(1.0, abs(ref.objective))
+    if sol.selected is not None:
+        assert_feasible(p, sol)
+
+
+def test_node_budget_falls_back_to_lagrangian_exact():
+    p = AssignmentProblem.dense(np.random.default_rng(3).random((7, 7, 7)))
+    sol = solve(p, "bnb", max_nodes=1, probe_every=0, max_iter=1, recover_every=0)
+    assert_optimal(p, sol)
+    assert "lagrangian-exact" in sol.message and sol.info["bnb"]["nodes"] >= 1
+
+
+def test_too_large_for_dense_matrices(monkeypatch):
+    monkeypatch.setattr(bnb, "MAX_DENSE", 10)
+    p = AssignmentProblem.dense(np.random.default_rng(1).random((4, 4, 4)))
+    sol = solve(p, "bnb")
+    assert_optimal(p, sol)
+    assert "MAX_DENSE" in sol.message
+    with pytest.raises(ProblemTooLargeError, match="dense"):
+        solve(p, "bnb", fallback=False)
+
+
+def test_infeasible_problems():
+    # the kept axes cannot be matched: both rows of axis 0 need row 1 of axis 1
+    p = AssignmentProblem.sparse((2, 2, 2), [[1, 1, 1], [2, 1, 2]], [1.0, 2.0])
+    assert solve(p, "bnb").status is Status.INFEASIBLE
+    # every index has a candidate, the kept-axes matching exists, no exact cover does
+    T = [[1, 1, 1], [2, 2, 1], [1, 2, 2], [2, 1, 2]]
+    p = AssignmentProblem.sparse((2, 2, 2), T, [1.0, 1.0, 1.0, 1.0])
+    assert solve(p, "highs").status is Status.INFEASIBLE
+    assert solve(p, "bnb").status is Status.INFEASIBLE
+
+
+def test_deterministic_and_records_parameters():
+    p = AssignmentProblem.dense(np.random.default_rng(2).random((8, 8, 8)))
+    a, b = solve(p, "bnb"), solve(p, "bnb")
+    assert np.array_equal(a.selected, b.selected)
+    assert a.info["iterations"] == b.info["iterations"] and a.info["nodes"] == b.info["nodes"]
+    assert set(bnb.DEFAULTS) <= set(a.info["parameters"])
+    assert a.info["parameters"]["keep_axes"] == [0, 1]
+
+
+def test_integer_costs_are_detected():
+    p = AssignmentProblem.dense(np.random.default_rng(4).integers(0, 50, (6, 6, 6)))
+    sol = solve(p, "bnb")
+    assert sol.info["integer_costs"] is True and sol.bound == sol.objective
+    assert_optimal(p, sol)
+
+
+@pytest.mark.parametrize("opts, match", [
+    ({"bogus": 1}, "bogus"), ({"max_nodes": 0}, "max_nodes"), ({"patience": 0}, "patience"),
+    ({"step0": 0.0}, "step0"), ({"deflect": 1.0}, "deflect"), ({"max_iter": -1}, "max_iter"),
+    ({"keep_axes": (1, 1)}, "keep_axes"), ({"keep_axes": (0, 7)}, "keep_axes"),
+])
+def test_bad_options_are_named(opts, match):
+    p = AssignmentProblem.dense(np.ones((3, 3, 3)))
+    with pytest.raises(InvalidProblemError, match=match):
+        solve(p, "bnb", **opts)
+
+
+def test_lp_relaxation_is_refused():
+    with pytest.raises(Exception, match="LP"):
+        solve(AssignmentProblem.dense(np.ones((2, 2, 2))), "bnb", relax="lp")
+
+
+def test_auto_picks_bnb_for_small_sd():
+    small = AssignmentProblem.dense(np.random.default_rng(0).random((5, 5, 5)))
+    assert choose_solver(small) == "bnb"
+    sol = solve(small)
+    assert sol.solver == "bnb"
+    assert_optimal(small, sol)
+
+
+def test_auto_without_numba_uses_lagrangian_exact(monkeypatch):
+    import assocopt.api as api
+    monkeypatch.setattr(api, "_numba_installed", lambda: False)
+    assert choose_solver(AssignmentProblem.dense(np.ones((3, 3, 3)))) == "lagrangian-exact"
+
+
+# ------------------------------------------------------------------- kernels
+@given(st.integers(0, 2 ** 32 - 1), st.integers(1, 9), st.sampled_from([0.0, 0.3]))
+def test_hungarian_matches_scipy_with_feasible_duals(seed, n, forbid):
+    rng = np.random.default_rng(seed)
+    A = rng.normal(size=(n, n))
+    A[rng.random((n, n)) < forbid] = np.inf
+    np.fill_diagonal(A, rng.normal(size=n))          # a finite matching exists
+    ok, col, u, v, cost = kern.hungarian(A)
+    r, c = linear_sum_assignment(np.where(np.isfinite(A), A, 1e12))
+    assert ok
+    assert cost == pytest.approx(A[r, c].sum(), abs=1e-9)
+    assert sorted(col.tolist()) == list(range(n))
+    assert A[np.arange(n), col].sum() == pytest.approx(cost, abs=1e-9)
+    finite = np.isfinite(A)
+    slack = A - u[:, None] - v[None, :]
+    assert (slack[finite] >= -1e-9).all()                         # dual feasible
+    assert np.allclose(slack[np.arange(n), col], 0.0, atol=1e-9)   # tight on the matching
+    assert u.sum() + v.sum() == pytest.approx(cost, abs=1e-9)
+
+
+def test_hungarian_reports_no_matching():
+    A = np.array([[1.0, np.inf], [2.0, np.inf]])
+    assert kern.hungarian(A)[0] is False
+
+
+@given(sd_problems(), st.integers(0, 2 ** 32 - 1))
+def test_reduced_cost_bound_is_valid_for_any_dual(p, seed):
+    """base + sum of max(r, 0) over the optimum never exceeds the optimum."""
+    ref = solve(p, "bruteforce")
+    if ref.status is not Status.OPTIMAL:
+        return
+    inp = bnb.BnbInput.build(p)
+    y = np.random.default_rng(seed).normal(size=len(inp.axis_of))
+    rp = np.empty(p.n_candidates)
+    base = kern.reduced(inp.G, inp.c, y, rp, inp.ptr, inp.lst, inp.axis_of)
+    assert base + rp[ref.selected].sum() <= ref.objective + 1e-9 * max(1, abs(ref.objective))
