@@ -402,7 +402,7 @@ def dfs(G, c, rp, base, ptr, lst, axis_of, n_axes, int_costs, tol, ub, best_sel,
             cost = 0.0
             for t in range(d + 1):
                 cost += c[stack_k[t]]
-            if ub == INF or cost < ub - 1e-12 * max(1.0, abs(ub)):
+            if cost < limit:
                 ub = cost
                 best_sel[:d + 1] = stack_k[:d + 1]
                 best_len = d + 1

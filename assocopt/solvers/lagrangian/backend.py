@@ -23,8 +23,9 @@ from .local_search import _LocalSearch
 from .options import _keep_axes, _parse
 from .reduction import dominated
 from .relaxation import _Relaxation
-from .window import (_CPSAT_BUDGET, _CPSAT_MAX, _PROBE_SEARCH_MAX, _SEARCH_MAX, _SEARCH_NODES,
-                     _cover_search, _cpsat, _grow, _has_ortools, _ilp, _uncovered)
+from .window import (_COMPILED_NODES, _CPSAT_BUDGET, _CPSAT_MAX, _PROBE_SEARCH_MAX,
+                     _SEARCH_MAX, _SEARCH_NODES, _compiled_search, _cover_search, _cpsat,
+                     _grow, _has_numba, _has_ortools, _ilp, _uncovered)
 
 #: The exact mode runs the local search only above this many candidates.
 _LS_MIN_K = 2000
@@ -134,12 +135,17 @@ class _LagrangianBase(Backend):
                 st.proof = "reduced-cost fixing left only the incumbent"
                 st.bound = max(st.bound, st.ub)
                 return "proven"
-            if n + len(st.incumbent) <= _PROBE_SEARCH_MAX:
+            compiled = _has_numba()
+            if n + len(st.incumbent) <= (8 if compiled else 1) * _PROBE_SEARCH_MAX:
                 win = np.union1d(gpos[keep], st.incumbent)
                 red_of = np.full(len(st.costs), np.inf)
                 red_of[gpos] = red
-                sel, complete = _cover_search(problem, win, red_of[win], base, st.ub,
-                                              node_limit=3_000)
+                if compiled:
+                    sel, complete = _compiled_search(problem, win, red_of[win], base,
+                                                     st.ub, st.integer, 3_000)
+                else:
+                    sel, complete = _cover_search(problem, win, red_of[win], base, st.ub,
+                                                  node_limit=3_000)
                 if complete:
                     if sel is not None:
                         st.offer(sel)
@@ -266,14 +272,20 @@ class _LagrangianBase(Backend):
         None or >= cap), ``kInfeasible`` (nothing below ``cap``), ``kObjectiveTarget``
         (a solution at the proven bound ``lo``: optimal), else a limit.
         """
-        if len(win) <= _SEARCH_MAX:
-            sel, complete = _cover_search(problem, win, red_of[win], base, cap,
-                                          node_limit=_SEARCH_NODES)
+        if _has_numba() or len(win) <= _SEARCH_MAX:
+            if _has_numba():
+                sel, complete = _compiled_search(problem, win, red_of[win], base, cap,
+                                                 st.integer, _COMPILED_NODES)
+                how = "compiled search"
+            else:
+                sel, complete = _cover_search(problem, win, red_of[win], base, cap,
+                                              node_limit=_SEARCH_NODES)
+                how = "search"
             if complete:
                 if sel is None:
-                    return "kInfeasible", None, "search"
+                    return "kInfeasible", None, how
                 st.offer(sel)
-                return "kOptimal", math.fsum(problem.costs[sel].tolist()), "search"
+                return "kOptimal", math.fsum(problem.costs[sel].tolist()), how
         start = closed and st.incumbent is not None
         use_cp = st.integer and (p["window_solver"] == "cpsat" or (
             p["window_solver"] == "auto" and len(win) <= _CPSAT_MAX and _has_ortools()))
