@@ -116,6 +116,28 @@ def test_exact_mode_with_options_equals_brute_force(p, opts):
     assert_optimal(p, sol)
 
 
+@settings(max_examples=25)
+@given(sd_problems(), st.sampled_from(["no numba", "tiny compiled budget"]),
+       st.sampled_from(["auto", "highs", "cpsat"]))
+def test_exact_mode_window_engines_equal_brute_force(p, how, window_solver):
+    """Windows settled by the Python search (numba absent) or passed on to CP-SAT /
+    HiGHS (compiled search out of nodes) give the same optimum."""
+    from assocopt.solvers.lagrangian import backend as lb_backend
+    if window_solver == "cpsat" and not np.all(p.costs == np.round(p.costs)):
+        window_solver = "auto"
+    with pytest.MonkeyPatch.context() as mp:
+        if how == "no numba":
+            mp.setattr(lb_backend, "_has_numba", lambda: False)
+        else:
+            mp.setattr(lb_backend, "_COMPILED_NODES", 1)
+        sol = solve(p, "lagrangian-exact", window_solver=window_solver)
+    opt = _optimum(p)
+    if opt is None:
+        assert sol.status is Status.INFEASIBLE
+        return
+    assert_optimal(p, sol)
+
+
 @given(sd_problems(dummies=True))
 def test_dominance_keeps_the_optimum(p):
     drop = lg.dominated(p.sizes, p.tuples, p.costs)
