@@ -54,6 +54,7 @@ def test_equals_brute_force(p):
 @given(sd_problems(), st.sampled_from([
     {"probe_every": 0}, {"recover_every": 0}, {"max_iter": 0}, {"max_iter": 1},
     {"deflect": 0.0, "patience": 1}, {"keep_axes": (0, 2)}, {"probe_nodes": 1},
+    {"warm_start": False},
 ]))
 def test_every_option_setting_stays_exact(p, opts):
     sol = solve(p, "bnb", **opts)
@@ -169,6 +170,21 @@ def test_hungarian_matches_scipy_with_feasible_duals(seed, n, forbid):
     assert (slack[finite] >= -1e-9).all()                         # dual feasible
     assert np.allclose(slack[np.arange(n), col], 0.0, atol=1e-9)   # tight on the matching
     assert u.sum() + v.sum() == pytest.approx(cost, abs=1e-9)
+
+
+@given(st.integers(0, 2 ** 32 - 1), st.integers(1, 9), st.sampled_from([0.0, 0.3]))
+def test_hungarian_warm_start_from_any_potentials(seed, n, forbid):
+    rng = np.random.default_rng(seed)
+    A = rng.normal(size=(n, n))
+    A[rng.random((n, n)) < forbid] = np.inf
+    np.fill_diagonal(A, rng.normal(size=n))
+    cold = kern.hungarian(A)
+    ok, col, u, v, cost = kern.hungarian_warm(A, rng.normal(scale=3.0, size=n))
+    assert ok and cost == pytest.approx(cold[4], abs=1e-9)
+    assert A[np.arange(n), col].sum() == pytest.approx(cost, abs=1e-9)
+    slack = A - u[:, None] - v[None, :]
+    assert (slack[np.isfinite(A)] >= -1e-9).all()
+    assert np.allclose(slack[np.arange(n), col], 0.0, atol=1e-9)
 
 
 def test_hungarian_reports_no_matching():

@@ -38,6 +38,18 @@ def hungarian(A):
     matching, and ``cost = sum(u) + sum(v)``; ``ok`` is False if no finite perfect
     matching exists.
     """
+    return hungarian_warm(A, np.empty(0))
+
+
+@njit(cache=True)
+def hungarian_warm(A, v0):
+    """:func:`hungarian` started from column potentials ``v0`` (length n; empty: cold).
+
+    Warm start (for the nearly unchanged matrices of successive subgradient
+    iterations): row potentials ``u[i] = min_j A[i, j] - v0[j]`` make the start dual
+    feasible, every row whose tight column is still free is matched at once, and only
+    the others are augmented.
+    """
     n = A.shape[0]
     u = np.zeros(n + 1)
     v = np.zeros(n + 1)
@@ -45,7 +57,27 @@ def hungarian(A):
     way = np.zeros(n + 1, np.int64)
     minv = np.empty(n + 1)
     used = np.empty(n + 1, np.bool_)
+    done = np.zeros(n + 1, np.bool_)
+    if v0.shape[0] == n:
+        for j in range(1, n + 1):
+            v[j] = v0[j - 1]
+        for i in range(1, n + 1):
+            m = INF
+            jm = -1
+            for j in range(1, n + 1):
+                val = A[i - 1, j - 1] - v[j]
+                if val < m:
+                    m = val
+                    jm = j
+            if jm < 0:
+                return False, np.zeros(n, np.int64), u[1:], v[1:], INF
+            u[i] = m
+            if p[jm] == 0:
+                p[jm] = i
+                done[i] = True
     for i in range(1, n + 1):
+        if done[i]:
+            continue
         p[0] = i
         j0 = 0
         minv[:] = INF
@@ -150,7 +182,8 @@ def prepare(T, off, sizes, c, a, b):
 
 
 @njit(cache=True)
-def evaluate(G, pa, pb, c, relaxed, off_a, off_b, y, na, nb, plain, r, yfull, chosen):
+def evaluate(G, pa, pb, c, relaxed, off_a, off_b, y, na, nb, plain, r, yfull, chosen,
+             vwarm, warm):
     """``L(y)`` of the relaxation that keeps axes ``a, b`` (``y`` is 0 on their rows).
 
     Fills ``r`` (reduced costs w.r.t. the relaxed multipliers), ``yfull`` (``y`` on the
@@ -191,9 +224,10 @@ def evaluate(G, pa, pb, c, relaxed, off_a, off_b, y, na, nb, plain, r, yfull, ch
             A[na + j, j] = Cm[j + 1]
             for i in range(na):
                 A[na + j, nb + i] = 0.0
-    ok, col, u, v, cost = hungarian(A)
+    ok, col, u, v, cost = hungarian_warm(A, vwarm if warm else vwarm[:0])
     if not ok:
         return False, -INF
+    vwarm[:] = v                         # the next iteration starts from these
     yfull[:] = y
     for i in range(na):
         yfull[off_a + i] = u[i] if plain else u[i] + v[nb + i]
@@ -497,7 +531,7 @@ INFEASIBLE = 2     # the kept axes admit no assignment
 @njit(cache=True)
 def solve(G, pa, pb, c, relaxed, a, b, off_a, off_b, na, nb, plain, axis_of, ptr, lst,
           int_costs, tol, y0, max_iter, probe_every, probe_budget, budget,
-          lam0, patience, lam_min, deflect, recover_every, n3, off_c, n_c):
+          lam0, patience, lam_min, deflect, recover_every, n3, off_c, n_c, warm_start):
     """Subgradient ascent on ``L(y)`` with periodic DFS probes, then a final DFS.
 
     Returns ``(outcome, best_sel, best_len, ub, bound, iterations, nodes)``.
@@ -513,6 +547,7 @@ def solve(G, pa, pb, c, relaxed, a, b, off_a, off_b, na, nb, plain, axis_of, ptr
     rfull = np.empty(K)
     g = np.zeros(E)
     dvec = np.zeros(E)
+    vwarm = np.zeros(na if plain else na + nb)
     best_sel = np.full(E + 1, -1, np.int64)
     best_len = -1
     ub = INF
@@ -534,7 +569,7 @@ def solve(G, pa, pb, c, relaxed, a, b, off_a, off_b, na, nb, plain, axis_of, ptr
     tmp_sel = np.empty(E + 1, np.int64)
     for it in range(1, max_iter + 1):
         ok, L = evaluate(G, pa, pb, c, relaxed, off_a, off_b, y, na, nb, plain, r,
-                         yfull, chosen)
+                         yfull, chosen, vwarm, warm_start and it > 1)
         if not ok:
             return INFEASIBLE, best_sel, best_len, ub, INF, it, nodes
         g[:] = 0.0
