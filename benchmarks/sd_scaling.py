@@ -7,8 +7,9 @@ Families (every instance is solved by every method in this one process):
 
 * the 120 axial 3-AP instances of ../shared/ap_instances (Grundel n = 5..50,
   Balas-Saltzman n = 4..26), with proven optima;
-* 3-AP with costs ``d_ij + d_ik + d_jk`` (random integer d in 1..100,
-  Crama-Spieksma-style): LP relaxation not integral;
+* 3-AP with costs ``d_ij + d_ik + d_jk`` (Crama-Spieksma-style, random integer d in
+  0..8, redrawn until the ILP optimum exceeds the LP bound by at least one cost
+  unit): integrality gaps 2.3..5.7% (see :func:`crama_spieksma`);
 * random S-D tracking instances with dummies: N = 3..6 sensors, 10..50 targets,
   P_D = 0.8, Poisson false alarms, gated tuples, negative log-likelihood-ratio costs;
 * paper 002's scenario (``assocopt.scenarios.lu2013``) when that package is present:
@@ -91,23 +92,26 @@ def ap_instances(ap_dir: Path, quick: bool) -> list[Instance]:
     return out
 
 
-def crama_spieksma(rng: np.random.Generator, n: int, hi: int = 5,
-                   fractional: bool = True, max_draws: int = 200) -> AssignmentProblem:
+def crama_spieksma(rng: np.random.Generator, n: int, hi: int = 8,
+                   min_gap: float = 1.0, max_draws: int = 200) -> AssignmentProblem:
     """3-AP with c_ijk = d_ij + d_ik + d_jk (Crama-Spieksma cost structure), the three
     n x n matrices d i.i.d. uniform integers in 0..hi (not metric: the triangle
     inequality of Crama-Spieksma's T-instances is not imposed).
 
-    ``fractional=True`` (default) redraws until the LP relaxation is not integral,
-    i.e. the LP optimum is below the ILP optimum (both by HiGHS, scipy's if highspy is
-    missing); after ``max_draws`` draws the last one is kept.  Without this condition
-    the LP is integral on most small draws (hi = 5: about 82% at n = 10, 50% at n = 15,
-    33% at n = 20..25), so ~5 draws are needed at n = 10, ~1.5 at n = 20..25.
+    Draws are repeated until ILP optimum - LP optimum >= ``min_gap`` cost units (both
+    by HiGHS, scipy's if highspy is missing; ``min_gap=0`` keeps the first draw; after
+    ``max_draws`` the last draw is kept).  With integer costs a gap under 1 unit is
+    closed by rounding the bound up, so min_gap = 1 keeps only instances whose LP
+    bound, even rounded, does not prove the optimum.  Unconditioned, the LP is
+    integral on most small draws (hi = 8: 81% at n = 10, 44% at n = 15 and 20, 17% at
+    n = 25) and 0 < gap < 1 unit on most of the rest; ILP - LP >= 1 held on 8% of
+    draws at n = 10, 12% at n = 15, 30% at n = 20..25 (so about 12, 8, 3 draws).
 
-    Measured gap (ILP - LP) / ILP, hi = 5, 91 LP-fractional draws at n = 10..25:
-    0.4..11.3% overall, inside 2..6% on 68% of them (n = 10: 15/19, 15: 16/24,
-    20: 17/24, 25: 14/24); median about 2.3% at n = 10 rising to about 5.5% at n = 25.
-    For comparison (5 seeds per n, unconditioned): d in 1..100 gives 0..2.5%, and
-    rounded Euclidean distances between random points in the plane give 0..0.4%.
+    Measured gap (ILP - LP) / ILP of the kept instances, hi = 8, min_gap = 1: 51
+    instances at n = 10..25, all inside 2.3..5.7% (median 3.1% at n = 10, 4.2% at
+    n = 25): a gap of 1 to 2 units on optima of about 20..45.  For comparison
+    (unconditioned, 5 seeds per n): d in 1..100 gives 0..2.5%, rounded Euclidean
+    distances between random points in the plane 0..0.4%.
     """
     cls = registered().get("highs")
     checker = "highs" if cls is not None and cls.is_available() else "scipy"
@@ -115,11 +119,11 @@ def crama_spieksma(rng: np.random.Generator, n: int, hi: int = 5,
         dij, dik, djk = (rng.integers(0, hi + 1, size=(n, n)).astype(float)
                          for _ in range(3))
         p = AssignmentProblem.dense(dij[:, :, None] + dik[:, None, :] + djk[None, :, :])
-        if not fractional:
+        if min_gap <= 0:
             break
         lp = solve(p, checker, relax="lp").objective
         ilp = solve(p, checker).objective
-        if ilp - lp > 1e-6 * max(1.0, abs(ilp)):
+        if ilp - lp >= min_gap - 1e-6:
             break
     return p
 
@@ -262,6 +266,8 @@ def plain_section(instances, log) -> list:
         it = r.info.get("iterations") or 1
         lp = run(inst.problem, "highs", relax="lp").objective
         opt = run(inst.problem, "auto").objective
+        if lp is not None and np.all(inst.problem.costs == np.round(inst.problem.costs)):
+            lp = math.ceil(lp - 1e-6)      # integer costs: bounds are rounded up
         r.info["lp_gap"] = (None if lp is None or opt is None
                             else (opt - lp) / max(abs(opt), 1e-12))
         out.append((inst, r, r.time / it))
@@ -654,7 +660,8 @@ def main(argv=None) -> int:
     P += ["", "## Plain `lagrangian`: gap after 100 iterations", "",
           "`solve(p, 'lagrangian', max_iter=100, gap_tol=0)`; each iteration is one pass "
           "over the candidates, one 2-D assignment and the primal recovery.  `LP gap`: "
-          "the integrality gap `(optimum - LP) / |optimum|`.  The Lagrangian bound never "
+          "the integrality gap `(optimum - LP) / |optimum|`, with the LP bound rounded up "
+          "for integer costs (as every bound is then).  The Lagrangian bound never "
           "exceeds the LP bound, so no Lagrangian method can certify a gap below it: the "
           "1% target is about S-D problems with dummies (tracking), where the LP is "
           "nearly integral; on the LP-gap 3-AP instances the gap shown is at least the "
