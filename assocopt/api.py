@@ -23,13 +23,18 @@ __all__ = ["solve", "choose_solver", "BNB_MAX_CANDIDATES"]
 #: ``lagrangian-exact`` up to Grundel n = 20 (8,000 candidates), slower at n = 30
 #: (docs/benchmarks-sd.md).
 BNB_MAX_CANDIDATES = 10_000
+#: ... and with at most this many real indices on the two kept axes: ``bnb``'s dense
+#: Hungarian costs O((n_a + n_b)^3) per iteration, ``lagrangian-exact``'s sparse LAP
+#: far less on large sparse problems.
+BNB_MAX_KEPT = 100
 
 
 def choose_solver(problem: AssignmentProblem, relax: str | None = None) -> str:
     """The back end ``solver="auto"`` picks, by size and structure (measured in
     docs/benchmarks-sd.md): the 2-D fast path; for S-D (N >= 3) the compiled branch
-    and bound ``bnb`` up to :data:`BNB_MAX_CANDIDATES` candidates (numba installed),
-    else the Lagrangian exact method; HiGHS for LP relaxations."""
+    and bound ``bnb`` up to :data:`BNB_MAX_CANDIDATES` candidates and
+    :data:`BNB_MAX_KEPT` kept-axes indices (numba installed), else the Lagrangian exact
+    method; HiGHS for LP relaxations."""
     if relax is not None:
         return "highs"
     if problem.ndim == 2:
@@ -40,8 +45,8 @@ def choose_solver(problem: AssignmentProblem, relax: str | None = None) -> str:
 
 
 def _bnb_usable(problem: AssignmentProblem) -> bool:
-    from .solvers.bnb import MAX_DENSE, dense_size
-    return _numba_installed() and dense_size(problem) <= MAX_DENSE
+    from .solvers.bnb import kept_sizes
+    return _numba_installed() and sum(kept_sizes(problem)) <= BNB_MAX_KEPT
 
 
 @functools.lru_cache(maxsize=None)

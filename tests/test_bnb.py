@@ -85,14 +85,29 @@ def test_node_budget_falls_back_to_lagrangian_exact():
     assert "lagrangian-exact" in sol.message and sol.info["bnb"]["nodes"] >= 1
 
 
-def test_too_large_for_dense_matrices(monkeypatch):
-    monkeypatch.setattr(bnb, "MAX_DENSE", 10)
+@pytest.mark.parametrize("limit", ["MAX_DENSE", "MAX_KEPT"])
+def test_too_large_for_dense_matrices(monkeypatch, limit):
+    monkeypatch.setattr(bnb, limit, 7)
     p = AssignmentProblem.dense(np.random.default_rng(1).random((4, 4, 4)))
     sol = solve(p, "bnb")
     assert_optimal(p, sol)
-    assert "MAX_DENSE" in sol.message
+    assert limit in sol.message
     with pytest.raises(ProblemTooLargeError, match="dense"):
         solve(p, "bnb", fallback=False)
+
+
+def test_auto_leaves_large_sparse_problems_to_lagrangian_exact():
+    # 300 x 300 x 3 with 1,500 candidates: few candidates, but a 600 x 600 Hungarian
+    rng = np.random.default_rng(0)
+    n = 300
+    singles = np.zeros((2 * n + 3, 3), np.int64)
+    singles[:n, 0] = singles[n:2 * n, 1] = np.arange(1, n + 1)
+    singles[2 * n:, 2] = [1, 2, 3]
+    pairs = np.stack([rng.integers(1, n + 1, 900), rng.integers(1, n + 1, 900),
+                      rng.integers(0, 4, 900)], axis=1)
+    T = np.unique(np.concatenate([singles, pairs]), axis=0)
+    p = AssignmentProblem.sparse((n, n, 3), T, rng.normal(size=len(T)))
+    assert choose_solver(p) == "lagrangian-exact"
 
 
 def test_infeasible_problems():

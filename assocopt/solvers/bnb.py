@@ -26,9 +26,8 @@ runs everything in one compiled call (numba, :mod:`assocopt.solvers.bnb_kernels`
 
 The search stops after ``max_nodes`` nodes; then, with ``fallback=True`` (default),
 the problem goes to ``lagrangian-exact`` with what is left of ``time_limit``, so the
-answer is still a proven optimum.  Problems whose kept-axes matrix
-``(n_a+1)(n_b+1)`` exceeds :data:`MAX_DENSE` entries go there directly (the kernels
-use dense 2-D matrices).  The compiled part does not check the clock: ``time_limit``
+answer is still a proven optimum.  Problems too large for the kernels' dense 2-D
+matrices (:data:`MAX_DENSE`, :data:`MAX_KEPT`) go there directly.  The compiled part does not check the clock: ``time_limit``
 applies to the fallback.  ``solver="auto"`` uses this back end for small N >= 3
 problems (see :func:`assocopt.api.choose_solver`).
 
@@ -68,7 +67,8 @@ from ..problem import AssignmentProblem
 from ..solution import Status
 from .base import Backend, RawResult, SolveOptions, register, get_backend
 
-__all__ = ["BranchBoundBackend", "DEFAULTS", "BnbInput", "MAX_DENSE", "dense_size"]
+__all__ = ["BranchBoundBackend", "DEFAULTS", "BnbInput", "MAX_DENSE", "MAX_KEPT",
+           "kept_sizes", "too_large"]
 
 #: Relative tolerance of "bound meets objective" for non-integer costs (round-off),
 #: the same as the Lagrangian back ends' ``OPT_TOL``.
@@ -77,6 +77,10 @@ TOL = 1e-9
 #: Largest dense matrix (entries) the kernels allocate: ``(n_a+1)(n_b+1)`` for the
 #: 2-D subproblem, ``(n_a+1)(n_b+1)(n_c+1)`` for the N = 3 recovery lookup.
 MAX_DENSE = 4_000_000
+#: Largest ``n_a + n_b`` (the dense Hungarian's size, misses included): each ascent
+#: iteration costs O((n_a + n_b)^3), so beyond this ``lagrangian-exact`` (sparse LAP)
+#: is the better engine.
+MAX_KEPT = 400
 
 DEFAULTS: dict[str, Any] = {
     "max_iter": 100, "probe_every": 15, "probe_nodes": 200, "max_nodes": 200_000,
@@ -85,10 +89,20 @@ DEFAULTS: dict[str, Any] = {
 }
 
 
-def dense_size(problem: AssignmentProblem, keep_axes: Any = None) -> int:
-    """Entries of the kernels' 2-D matrix ``(n_a+1)(n_b+1)`` for the kept axes."""
+def kept_sizes(problem: AssignmentProblem, keep_axes: Any = None) -> tuple[int, int]:
+    """``(n_a, n_b)``: the sizes of the two kept axes."""
     a, b = _keep(problem.sizes, keep_axes)
-    return (problem.sizes[a] + 1) * (problem.sizes[b] + 1)
+    return problem.sizes[a], problem.sizes[b]
+
+
+def too_large(problem: AssignmentProblem, keep_axes: Any = None) -> str | None:
+    """Why the kernels' dense matrices do not suit ``problem`` (None: they do)."""
+    na, nb = kept_sizes(problem, keep_axes)
+    if (na + 1) * (nb + 1) > MAX_DENSE:
+        return f"(n_a+1)(n_b+1) = {(na + 1) * (nb + 1)} > MAX_DENSE = {MAX_DENSE}"
+    if na + nb > MAX_KEPT:
+        return f"n_a + n_b = {na + nb} > MAX_KEPT = {MAX_KEPT}"
+    return None
 
 
 @dataclass(frozen=True)
@@ -182,18 +196,17 @@ class BranchBoundBackend(Backend):
         t0 = time.perf_counter()
         from . import bnb_kernels as kern      # imports numba: only when asked for
 
+        why = too_large(problem, p["keep_axes"])
+        if why is not None:
+            if not p["fallback"]:
+                raise ProblemTooLargeError(
+                    f"solver 'bnb' works on dense kept-axes matrices and this problem is "
+                    f"too large for them ({why}); use 'lagrangian-exact' or fallback=True")
+            return self._fallback(problem, options, {"parameters": dict(p), "reason": why},
+                                  t0)
         inp = BnbInput.build(problem, p["keep_axes"])
         na, nb = problem.sizes[inp.a], problem.sizes[inp.b]
         probe_nodes = p["probe_nodes"]
-        if (na + 1) * (nb + 1) > MAX_DENSE:
-            info = {"parameters": dict(p), "reason": f"(n_a+1)(n_b+1) = "
-                    f"{(na + 1) * (nb + 1)} > MAX_DENSE = {MAX_DENSE}"}
-            if not p["fallback"]:
-                raise ProblemTooLargeError(
-                    f"solver 'bnb' uses dense matrices of (n_a+1)(n_b+1) = "
-                    f"{(na + 1) * (nb + 1)} entries, more than {MAX_DENSE}; use "
-                    "'lagrangian-exact' or fallback=True")
-            return self._fallback(problem, options, info, t0)
         T = problem.tuples
         # N = 3: primal recovery through a dense (n_a+1)(n_b+1)(n_c+1) tuple lookup
         n3 = problem.ndim == 3 and math.prod(s + 1 for s in problem.sizes) <= MAX_DENSE
