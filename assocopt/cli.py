@@ -358,6 +358,21 @@ def _solve_record(problem: Any, sol: Solution) -> dict[str, Any]:
 
 
 # ------------------------------------------------------------------ commands
+def _compile_note(problem: Any, solver: str, relax: str | None, err: TextIO) -> None:
+    """One line on stderr before the numba kernels are compiled (first run only)."""
+    from .api import choose_solver
+    from .solvers import get_backend
+
+    name = choose_solver(problem, relax) if solver == "auto" else solver
+    if relax is not None or name not in ("bnb", "lagrangian-exact") or \
+            not get_backend("bnb").is_available():
+        return
+    from .solvers import bnb_kernels
+    if not bnb_kernels.cached():
+        print("assocopt: compiling the numba kernels (first run only, about 15-30 s; "
+              "cached afterwards)", file=err)
+
+
 def _cmd_solve(args: argparse.Namespace, out: TextIO, err: TextIO) -> int:
     from .api import solve
     from .io import read_instance, write_solution
@@ -372,10 +387,12 @@ def _cmd_solve(args: argparse.Namespace, out: TextIO, err: TextIO) -> int:
             raise AssocoptError(f"--relax {args.relax} conflicts with model {model.name!r} "
                                 f"(formulation {model.formulation!r})")
         problem = read_instance(args.file, format=args.format, instance=args.instance)
+        _compile_note(problem, model.solver, model.relax, err)
         sol = model.solve(problem, time_limit=args.time_limit, mip_gap=args.gap,
                           threads=args.threads)
     else:
         problem = read_instance(args.file, format=args.format, instance=args.instance)
+        _compile_note(problem, args.solver or "auto", args.relax, err)
         sol = solve(problem, args.solver or "auto", relax=args.relax,
                     time_limit=args.time_limit,
                     mip_gap=0.0 if args.gap is None else args.gap, threads=args.threads)

@@ -218,3 +218,18 @@ def test_reduced_cost_bound_is_valid_for_any_dual(p, seed):
     rp = np.empty(p.n_candidates)
     base = kern.reduced(inp.G, inp.c, y, rp, inp.ptr, inp.lst, inp.axis_of)
     assert base + rp[ref.selected].sum() <= ref.objective + 1e-9 * max(1, abs(ref.objective))
+
+
+def test_cli_says_when_it_compiles(monkeypatch, capsys):
+    from pathlib import Path
+    from assocopt.cli import main
+    example = Path(__file__).resolve().parents[1] / "instances" / "example-3d.json"
+    monkeypatch.setattr(kern, "cached", lambda: False)
+    assert main(["solve", str(example)]) == 0
+    assert "compiling the numba kernels" in capsys.readouterr().err
+    monkeypatch.setattr(kern, "cached", lambda: True)
+    assert main(["solve", str(example)]) == 0
+    assert capsys.readouterr().err == ""
+    monkeypatch.setattr(kern, "cached", lambda: False)
+    assert main(["solve", str(example), "--solver", "highs"]) == 0
+    assert capsys.readouterr().err == ""

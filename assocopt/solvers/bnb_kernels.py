@@ -651,3 +651,15 @@ def solve(G, pa, pb, c, relaxed, a, b, off_a, off_b, na, nb, plain, axis_of, ptr
     if out == COMPLETE:
         return PROVEN, best_sel, best_len, ub, best_L, it, nodes
     return STOPPED, best_sel, best_len, ub, best_L, it, nodes
+
+
+def cached() -> bool:
+    """Whether compiled code of the main kernels is on disk (so the first call loads it
+    instead of compiling for 15-30 s).  Reads numba's cache index paths, which are not
+    public API: on any surprise it answers True (no warning rather than a wrong one)."""
+    import os
+    try:
+        return all(os.path.exists(f._cache._cache_file._index_path)
+                   for f in (solve, dfs, prepare))
+    except Exception:
+        return True
