@@ -30,7 +30,7 @@ from assocopt.solvers import registered  # noqa: E402
 AP = ROOT.parent / "shared" / "ap_instances"
 REFERENCE = "scipy"
 DEFAULT_SOLVERS = ["scipy", "highs", "ortools-cpsat", "ortools-mip", "cvxpy", "scipy-lsa",
-                   "lagrangian-exact", "auto"]
+                   "lagrangian-exact", "bnb", "auto"]
 
 
 def instances(max_n: int, per_size: int) -> list[tuple[str, float]]:
