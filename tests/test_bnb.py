@@ -18,31 +18,14 @@ from scipy.optimize import linear_sum_assignment
 
 from assocopt import (AssignmentProblem, InvalidProblemError, ProblemTooLargeError,
                       Status, choose_solver, solve)
-from assocopt.testing import assert_feasible, assert_optimal, random_problem
+from assocopt.testing import assert_feasible, assert_optimal
+
+from conftest import sd_problems
 
 pytest.importorskip("numba", reason="the bnb back end needs numba")
 
 from assocopt.solvers import bnb  # noqa: E402
 from assocopt.solvers import bnb_kernels as kern  # noqa: E402
-
-
-def _sd(rng: np.random.Generator, N: int, dummies: bool, integer: bool) -> AssignmentProblem:
-    if dummies:
-        hi = {3: 4, 4: 3, 5: 3}[N]
-        sizes = tuple(int(v) for v in rng.integers(1, hi, size=N))
-        return random_problem(rng, "sd", sizes=sizes, integer=integer,
-                              keep=float(rng.choice([0.3, 0.6, 1.0])))
-    n = int(rng.integers(1, {3: 5, 4: 4, 5: 3}[N]))
-    C = rng.integers(-5, 20, size=(n,) * N).astype(float) if integer else rng.normal(
-        size=(n,) * N)
-    return AssignmentProblem.dense(C)
-
-
-@st.composite
-def sd_problems(draw):
-    N = draw(st.integers(3, 5))
-    rng = np.random.default_rng(draw(st.integers(0, 2 ** 32 - 1)))
-    return _sd(rng, N, draw(st.booleans()), draw(st.booleans()))
 
 
 @given(sd_problems())

@@ -25,34 +25,9 @@ from assocopt.solvers.lap import (LapInfeasibleError, assign_with_misses,
                                   assignment_duals, lapx_available, linear_assignment)
 from assocopt.testing import assert_feasible, assert_optimal, random_problem
 
-from conftest import AP_INSTANCES
+from conftest import AP_INSTANCES, sd_problems
 
 TOL = 1e-7
-
-
-# ------------------------------------------------------------------- generators
-def _sd(rng: np.random.Generator, N: int, dummies: bool, integer: bool) -> AssignmentProblem:
-    """A small random S-D problem that brute force settles quickly."""
-    if dummies:
-        hi = {3: 4, 4: 3, 5: 3}[N]
-        sizes = tuple(int(v) for v in rng.integers(1, hi, size=N))
-        return random_problem(rng, "sd", sizes=sizes, integer=integer,
-                              keep=float(rng.choice([0.3, 0.6, 1.0])))
-    if rng.random() < 0.25:                       # rectangular: zero-cost slack
-        shape = tuple(int(v) for v in rng.integers(1, 4, size=N))
-    else:
-        n = int(rng.integers(1, {3: 5, 4: 4, 5: 3}[N]))
-        shape = (n,) * N
-    C = rng.integers(-5, 20, size=shape).astype(float) if integer else rng.normal(size=shape)
-    return AssignmentProblem.dense(C)
-
-
-@st.composite
-def sd_problems(draw, dummies=None):
-    N = draw(st.integers(3, 5))
-    seed = draw(st.integers(0, 2 ** 32 - 1))
-    use_dummies = draw(st.booleans()) if dummies is None else dummies
-    return _sd(np.random.default_rng(seed), N, use_dummies, draw(st.booleans()))
 
 
 def _optimum(p: AssignmentProblem) -> float | None:

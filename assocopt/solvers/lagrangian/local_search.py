@@ -43,7 +43,7 @@ class _LocalSearch:
     def improve(self, sel: np.ndarray, max_sweeps: int = 20) -> np.ndarray:
         if not self.ok:
             return sel
-        T, c, N = self.T, self.c, len(self.sizes)
+        c, N = self.c, len(self.sizes)
         cur = np.asarray(sel, np.int64)
         cost = float(c[cur].sum())
         stale = 0

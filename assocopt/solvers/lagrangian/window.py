@@ -51,13 +51,18 @@ def _grow(n: int, integer: bool) -> int:
     return int(n * (1.25 if integer else 2.0)) + 1
 
 
-@functools.lru_cache(maxsize=1)
-def _has_numba() -> bool:
+@functools.lru_cache(maxsize=None)
+def _installed(module: str) -> bool:
+    """Whether ``module`` can be imported (looked up once: find_spec is not free)."""
     import importlib.util
     try:
-        return importlib.util.find_spec("numba") is not None
+        return importlib.util.find_spec(module) is not None
     except (ImportError, ValueError):
         return False
+
+
+def _has_numba() -> bool:
+    return _installed("numba")
 
 
 def _compiled_search(problem: AssignmentProblem, pos: np.ndarray, red: np.ndarray,
@@ -80,13 +85,8 @@ def _compiled_search(problem: AssignmentProblem, pos: np.ndarray, red: np.ndarra
     return (pos[best[:n]] if n > 0 else None), out == kern.COMPLETE
 
 
-@functools.lru_cache(maxsize=1)
 def _has_ortools() -> bool:
-    import importlib.util
-    try:
-        return importlib.util.find_spec("ortools") is not None
-    except (ImportError, ValueError):
-        return False
+    return _installed("ortools")
 
 
 def _uncovered(problem: AssignmentProblem, pos: np.ndarray) -> np.ndarray:
