@@ -1,0 +1,59 @@
+"""The entry point :func:`main`: parse, dispatch to a subcommand, map errors to exit codes.
+
+Every failure ends here as one ``assocopt: error: ...`` line on stderr and an exit code
+(see :mod:`assocopt.cli`), never a traceback.
+"""
+
+from __future__ import annotations
+
+import sys
+from typing import Sequence
+
+from ..errors import AssocoptError
+from .common import (EXIT_BAD_INPUT, EXIT_BROKEN_PIPE, EXIT_INTERNAL, EXIT_INTERRUPTED,
+                     _error, _one_line, _os_message, _UsageError)
+from .parser import _build_parser
+from .solve_cmds import _cmd_compare, _cmd_solve, _cmd_solvers, _cmd_validate
+from .workflow_cmds import (_cmd_convert, _cmd_export, _cmd_generate, _cmd_instances,
+                            _cmd_models, _cmd_reproduce)
+
+
+def main(argv: Sequence[str] | None = None) -> int:
+    """Run the command line; returns the exit code (see :mod:`assocopt.cli`)."""
+    out, err = sys.stdout, sys.stderr
+    try:
+        parser = _build_parser()
+        args = parser.parse_args(list(sys.argv[1:] if argv is None else argv))
+        commands = {"solve": _cmd_solve, "solvers": _cmd_solvers, "models": _cmd_models,
+                    "compare": _cmd_compare, "validate": _cmd_validate,
+                    "export": _cmd_export, "generate": _cmd_generate,
+                    "convert": _cmd_convert, "instances": _cmd_instances,
+                    "reproduce": _cmd_reproduce}
+        return commands[args.command](args, out, err)
+    except SystemExit as exc:        # --help / --version
+        code = exc.code
+        return code if isinstance(code, int) else (0 if code is None else EXIT_BAD_INPUT)
+    except _UsageError as exc:
+        _error(err, f"{exc} (see 'assocopt --help')")
+        return EXIT_BAD_INPUT
+    except AssocoptError as exc:
+        _error(err, str(exc))
+        return EXIT_BAD_INPUT
+    except BrokenPipeError:          # output piped into `head` and closed: stop quietly
+        try:
+            import os
+            os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())
+        except (OSError, ValueError):
+            pass
+        return EXIT_BROKEN_PIPE
+    except OSError as exc:
+        _error(err, _os_message(exc))
+        return EXIT_BAD_INPUT
+    except KeyboardInterrupt:
+        print("assocopt: interrupted", file=err)
+        return EXIT_INTERRUPTED
+    except Exception as exc:  # noqa: BLE001 - the CLI never shows a traceback
+        _error(err, f"internal error ({type(exc).__name__}: {_one_line(str(exc))}); "
+                    "this is a bug in assocopt or a back end, please report it")
+        return EXIT_INTERNAL
+

@@ -1,0 +1,202 @@
+"""The solving subcommands: ``solve``, ``solvers``, ``compare`` and ``validate``.
+
+Each ``_cmd_*`` takes the parsed arguments and the output / error streams and returns an
+exit code; library modules are imported inside the functions (as before the split) so that
+``assocopt --help`` stays fast and tests can patch e.g. ``assocopt.api.solve``.
+"""
+
+from __future__ import annotations
+
+import argparse
+import io
+import json
+from pathlib import Path
+from typing import Any, TextIO
+
+from ..errors import AssocoptError
+from .common import (EXIT_BAD_INPUT, EXIT_INTERNAL, EXIT_LIMIT, EXIT_OK, _error, _human,
+                     _matches, _num, _one_line, _os_message, _solve_record, _table, exit_code)
+
+
+def _compile_note(problem: Any, solver: str, relax: str | None, err: TextIO) -> None:
+    """One line on stderr before the numba kernels are compiled (first run only)."""
+    from ..api import choose_solver
+    from ..solvers import get_backend
+
+    name = choose_solver(problem, relax) if solver == "auto" else solver
+    if relax is not None or name not in ("bnb", "lagrangian-exact") or \
+            not get_backend("bnb").is_available():
+        return
+    from ..solvers import bnb_kernels
+    if not bnb_kernels.cached():
+        print("assocopt: compiling the numba kernels (first run only, about 15-30 s; "
+              "cached afterwards)", file=err)
+
+
+def _cmd_solve(args: argparse.Namespace, out: TextIO, err: TextIO) -> int:
+    from ..api import solve
+    from ..io import read_instance, write_solution
+
+    if args.model is not None:
+        from ..models import load_model
+
+        if args.solver is not None:
+            raise AssocoptError("give --solver or --model, not both")
+        model = load_model(args.model)
+        if args.relax is not None and args.relax != model.relax:
+            raise AssocoptError(f"--relax {args.relax} conflicts with model {model.name!r} "
+                                f"(formulation {model.formulation!r})")
+        problem = read_instance(args.file, format=args.format, instance=args.instance)
+        _compile_note(problem, model.solver, model.relax, err)
+        sol = model.solve(problem, time_limit=args.time_limit, mip_gap=args.gap,
+                          threads=args.threads)
+    else:
+        problem = read_instance(args.file, format=args.format, instance=args.instance)
+        _compile_note(problem, args.solver or "auto", args.relax, err)
+        sol = solve(problem, args.solver or "auto", relax=args.relax,
+                    time_limit=args.time_limit,
+                    mip_gap=0.0 if args.gap is None else args.gap, threads=args.threads)
+    record = _solve_record(problem, sol)
+    if args.out:
+        write_solution(sol, args.out, extra={k: record[k] for k in
+                                            ("instance", "sizes", "optimum",
+                                             "matches_recorded_optimum") if k in record})
+    if args.json:
+        print(json.dumps(record, allow_nan=False), file=out)
+    else:
+        _human(problem, sol, out)
+    code = exit_code(sol)
+    if code == EXIT_INTERNAL:
+        print(f"assocopt: error: solver {sol.solver!r} failed (internal error): "
+              f"{_one_line(sol.message) or 'no message'}", file=err)
+    elif code == EXIT_LIMIT:
+        print("assocopt: error: stopped by a limit before any solution was found", file=err)
+    return code
+
+
+def _solver_rows() -> list[dict[str, Any]]:
+    from ..solvers import registered
+
+    rows = []
+    for name, cls in sorted(registered().items()):
+        try:
+            installed = bool(cls.is_available())
+        except Exception:  # a broken back end must not break the listing
+            installed = False
+        try:
+            version = cls.version() if installed else ""
+        except Exception:
+            version = ""
+        rows.append({
+            "name": name,
+            "installed": installed,
+            "version": version or None,
+            "package": cls.distribution,
+            "ilp": bool(cls.integer),
+            "lp": bool(cls.lp),
+            "exact": bool(cls.exact),
+            "gives_bound": bool(cls.gives_bound),
+            "max_ndim": cls.max_ndim,
+            "time_limit": bool(cls.supports_time_limit),
+            "description": cls.description,
+        })
+    return rows
+
+
+def _cmd_solvers(args: argparse.Namespace, out: TextIO, err: TextIO) -> int:
+    rows = _solver_rows()
+    if args.json:
+        print(json.dumps(rows, indent=2), file=out)
+        return EXIT_OK
+    if not rows:
+        print("no back ends registered", file=out)
+        return EXIT_OK
+    yes = {True: "yes", False: "-"}
+    table = [("name", "installed", "version", "ILP", "LP", "exact", "max N", "description")]
+    for r in rows:
+        table.append((r["name"], "yes" if r["installed"] else "no",
+                      r["version"] or "-", yes[r["ilp"]], yes[r["lp"]], yes[r["exact"]],
+                      "any" if r["max_ndim"] is None else str(r["max_ndim"]),
+                      r["description"] or ""))
+    _table(table, out)
+    return EXIT_OK
+
+
+def _cmd_compare(args: argparse.Namespace, out: TextIO, err: TextIO) -> int:
+    from ..compare import compare
+
+    res = compare(args.files, solvers=args.solvers, models=args.models,
+                  time_limit=args.time_limit, relax=args.relax, repeat=args.repeat,
+                  format=args.format, instance=args.instance, progress=args.progress)
+    fmt = "json" if args.json else "csv" if args.csv else "text"
+    if args.out:
+        from ..io import _atomic_write
+        buf = io.StringIO()
+        res.write(buf, fmt)
+        _atomic_write(Path(args.out), buf.getvalue())
+        print(f"wrote {args.out}: {len(res.rows)} rows ({fmt})", file=out)
+    else:
+        res.write(out, fmt)
+    if args.check:
+        bad = res.disagreements() + res.errors()
+        if bad:
+            r = bad[0]
+            _error(err, f"{len(bad)} run(s) failed the check; first: {r['instance']} / "
+                        f"{r['method']}: status {r['status']}, objective "
+                        f"{_num(r['objective'])}, recorded optimum {_num(r['optimum'])}"
+                        + (f" ({r['message']})" if r["message"] else ""))
+            return EXIT_INTERNAL
+    return EXIT_OK
+
+
+def _validate_one(path: str, args: argparse.Namespace) -> dict[str, Any]:
+    from ..generate import feasibility, prove_optimum
+    from ..io import read_instance
+
+    rec: dict[str, Any] = {"file": path, "ok": False}
+    try:
+        p = read_instance(path, format=args.format, instance=args.instance)
+    except (AssocoptError, OSError) as exc:
+        rec["error"] = _os_message(exc) if isinstance(exc, OSError) else str(exc)
+        return rec
+    rec.update(name=p.name, kind=p.kind, sizes=list(p.sizes),
+               candidates=int((~p.slack).sum()), optimum=p.optimum)
+    feasible, why = feasibility(p, time_limit=args.time_limit)
+    rec.update(feasible=feasible, feasibility=why)
+    if feasible is False:
+        rec["error"] = f"{path}: infeasible: {why}"
+        return rec
+    if args.check_optimum:
+        try:
+            proven, how = prove_optimum(p, time_limit=args.time_limit)
+        except AssocoptError as exc:
+            rec["error"] = f"{path}: {exc}"
+            return rec
+        rec["proven_optimum"] = proven
+        if p.optimum is not None and not _matches(proven, p.optimum):
+            rec["error"] = (f"{path}: recorded optimum {_num(p.optimum)} but {how} gives "
+                            f"{_num(proven)}")
+            return rec
+    rec["ok"] = True
+    return rec
+
+
+def _cmd_validate(args: argparse.Namespace, out: TextIO, err: TextIO) -> int:
+    code = EXIT_OK
+    for path in args.files:
+        rec = _validate_one(path, args)
+        if args.json:
+            print(json.dumps(rec, allow_nan=False), file=out)
+        elif rec["ok"]:
+            sizes = "x".join(map(str, rec["sizes"]))
+            opt = "no recorded optimum" if rec["optimum"] is None else \
+                f"recorded optimum {_num(rec['optimum'])}" + \
+                (" (confirmed by HiGHS)" if "proven_optimum" in rec else "")
+            feas = "feasible" if rec["feasible"] else "feasibility undecided"
+            print(f"ok  {path}: {rec['kind']}, sizes {sizes}, {rec['candidates']} "
+                  f"candidates; {feas} ({rec['feasibility']}); {opt}", file=out)
+        if not rec["ok"]:
+            _error(err, rec["error"])
+            code = EXIT_BAD_INPUT
+    return code
+
