@@ -81,7 +81,7 @@ DEFAULTS: dict[str, Any] = {
     "region_km": ((0.0, 50.0), (0.0, 50.0), (1.0, 10.0)),
     "line_direction": "x",
     # "highs", not "auto": when this was written "auto" resolved to "lagrangian-exact"
-    # for S-D, which raised TypeError (lagrangian.py _close_gap, incumbent None) or
+    # for S-D, which raised TypeError (lagrangian _close_gap, incumbent None) or
     # searched for minutes on some of the small restricted ILPs left by the fixing step.
     "solver": "highs",
     "ilp_strategy": "lp-fixing",

@@ -1,0 +1,65 @@
+"""Reader of the DecompLib / Grundel generator format (``ap3.<n>.<s>.txt``).
+
+Line 1 ``d``, line 2 the ``d`` sizes, then the costs with the last index varying
+fastest; the recorded optimum comes from a sibling ``ap3.<n>.<s>.sol`` (``OPT:``
+line) or an ``ap3.opt`` table.  :data:`_MAX_D` is shared with :mod:`.detect`.
+"""
+
+from __future__ import annotations
+
+import math
+import re
+from pathlib import Path
+
+from ..problem import AssignmentProblem
+from .common import _NUMBER, _count_error, _dense, _fail, _header_int, _lines, _numbers
+
+#: Largest dimension count accepted in a Grundel header.
+_MAX_D = 16
+
+
+def _read_grundel(path: Path, text: str) -> AssignmentProblem:
+    lines = _lines(text)
+    if len(lines) < 2:
+        raise _fail(path, "Grundel format needs a line 'd' and a line with the d sizes")
+    if len(lines[0]) != 1:
+        raise _fail(path, f"Grundel format: line 1 must hold only d, found {' '.join(lines[0][:5])!r}")
+    d = _header_int(path, lines[0][0], "d (line 1)")
+    if not 2 <= d <= _MAX_D:
+        raise _fail(path, f"Grundel format: d = {d} on line 1 is not in 2..{_MAX_D}")
+    tokens = text.split()
+    if len(tokens) < 1 + d:
+        raise _fail(path, f"Grundel format: line 2 must give {d} sizes")
+    sizes = tuple(_header_int(path, t, "a size (line 2)") for t in tokens[1:1 + d])
+    if any(n < 1 for n in sizes):
+        raise _fail(path, f"Grundel format: sizes must be positive, found {list(sizes)}")
+    expected = math.prod(sizes)
+    cost_tokens = tokens[1 + d:]
+    if len(cost_tokens) != expected:
+        raise _count_error(path, expected, len(cost_tokens),
+                           f"Grundel {'x'.join(map(str, sizes))} instance")
+    values = _numbers(path, text, cost_tokens, 1 + d)
+    optimum, source = _grundel_optimum(path)
+    meta = {"optimum_source": source} if source else {}
+    return _dense(path, values, sizes, path.stem, optimum, "grundel", **meta)
+
+
+def _grundel_optimum(path: Path) -> tuple[float | None, str | None]:
+    sol = path.with_suffix(".sol")
+    try:
+        if sol.is_file():
+            for line in sol.read_text(encoding="utf-8", errors="replace").splitlines():
+                if line.strip():
+                    m = re.match(r"^\s*OPT\s*:\s*(\S+)\s*$", line)
+                    if m and _NUMBER.match(m.group(1)):
+                        return float(m.group(1)), f"{sol.name} (OPT line)"
+                    break
+        table = path.parent / "ap3.opt"
+        if table.is_file():
+            for line in table.read_text(encoding="utf-8", errors="replace").splitlines():
+                parts = line.split()
+                if len(parts) == 2 and parts[0] == path.stem and _NUMBER.match(parts[1]):
+                    return float(parts[1]), "ap3.opt"
+    except OSError:
+        pass
+    return None, None
