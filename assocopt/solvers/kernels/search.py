@@ -1,0 +1,140 @@
+"""Depth-first exact-cover branch and bound on reduced costs (compiled)."""
+
+from __future__ import annotations
+
+import numpy as np
+from numba import njit
+
+from .relaxation import improve_limit
+
+INF = np.inf
+
+# DFS outcomes
+COMPLETE = 0       # search exhausted: the incumbent (if any) is optimal
+BUDGET = 1         # node budget spent
+
+
+@njit(cache=True)
+def _free(G, k, covered):
+    for s in range(G.shape[1]):
+        e = G[k, s]
+        if e >= 0 and covered[e]:
+            return False
+    return True
+
+
+@njit(cache=True)
+def _select(G, rp, ptr, lst, axis_of, covered, slack, rem):
+    """Branching row: the uncovered row with the fewest live candidates (Knuth's
+    rule).  ``slack`` = limit - base - acc.  Returns ``(row, bound)``; row -1: some
+    row has no live candidate (dead node).  ``bound`` = max over axes of the sum of
+    each uncovered row's least live reduced cost (one candidate per row per axis)."""
+    rem[:] = 0.0
+    best_e = -1
+    best_cnt = 1 << 60
+    for e in range(ptr.shape[0] - 1):
+        if covered[e]:
+            continue
+        cnt = 0
+        first = 0.0
+        for p in range(ptr[e], ptr[e + 1]):
+            k = lst[p]
+            if rp[k] >= slack:
+                break
+            if _free(G, k, covered):
+                if cnt == 0:
+                    first = rp[k]
+                cnt += 1
+                if cnt >= best_cnt:
+                    break
+        if cnt == 0:
+            return -1, INF
+        rem[axis_of[e]] += first
+        if cnt < best_cnt:
+            best_cnt = cnt
+            best_e = e
+    return best_e, rem.max()
+
+
+@njit(cache=True)
+def dfs(G, c, rp, base, ptr, lst, axis_of, n_axes, int_costs, tol, ub, best_sel,
+        best_len, budget):
+    """Depth-first exact-cover search for a solution cheaper than ``ub``.
+
+    Candidates are tried cheapest reduced cost first; a node is cut when
+    ``base + acc + bound`` reaches the improvement limit.  Returns ``(outcome, ub,
+    best_len, nodes)``; ``best_sel[:best_len]`` holds the incumbent.  ``COMPLETE``
+    means no solution cheaper than the returned ``ub`` exists.
+    """
+    E = ptr.shape[0] - 1
+    covered = np.zeros(E, np.bool_)
+    rem = np.zeros(n_axes)
+    stack_e = np.empty(E + 1, np.int64)
+    stack_p = np.empty(E + 1, np.int64)
+    stack_k = np.full(E + 1, -1, np.int64)
+    limit = improve_limit(ub, int_costs, tol)
+    nodes = 0
+    ncov = 0
+    acc = 0.0
+    e0, bnd = _select(G, rp, ptr, lst, axis_of, covered, limit - base, rem)
+    if e0 < 0 or base + bnd >= limit:
+        return COMPLETE, ub, best_len, nodes
+    d = 0
+    stack_e[0] = e0
+    stack_p[0] = ptr[e0]
+    stack_k[0] = -1
+    while d >= 0:
+        k = stack_k[d]
+        if k >= 0:                                  # undo the last choice here
+            for s in range(n_axes):
+                e = G[k, s]
+                if e >= 0:
+                    covered[e] = False
+                    ncov -= 1
+            acc -= rp[k]
+            stack_k[d] = -1
+        e = stack_e[d]
+        p = stack_p[d]
+        found = -1
+        slack = limit - base - acc
+        while p < ptr[e + 1]:
+            k = lst[p]
+            p += 1
+            if rp[k] >= slack:
+                p = ptr[e + 1]
+                break
+            if _free(G, k, covered):
+                found = k
+                break
+        stack_p[d] = p
+        if found < 0:
+            d -= 1
+            continue
+        for s in range(n_axes):
+            e = G[found, s]
+            if e >= 0:
+                covered[e] = True
+                ncov += 1
+        acc += rp[found]
+        stack_k[d] = found
+        nodes += 1
+        if ncov == E:                               # leaf: an exact cover
+            cost = 0.0
+            for t in range(d + 1):
+                cost += c[stack_k[t]]
+            if cost < limit:
+                ub = cost
+                best_sel[:d + 1] = stack_k[:d + 1]
+                best_len = d + 1
+                limit = improve_limit(ub, int_costs, tol)
+            continue
+        if nodes >= budget:
+            return BUDGET, ub, best_len, nodes
+        e2, bnd = _select(G, rp, ptr, lst, axis_of, covered, limit - base - acc, rem)
+        if e2 < 0 or base + acc + bnd >= limit:
+            continue
+        d += 1
+        stack_e[d] = e2
+        stack_p[d] = ptr[e2]
+        stack_k[d] = -1
+    return COMPLETE, ub, best_len, nodes
