@@ -37,7 +37,7 @@ def test_equals_brute_force(p):
 @given(sd_problems(), st.sampled_from([
     {"probe_every": 0}, {"recover_every": 0}, {"max_iter": 0}, {"max_iter": 1},
     {"deflect": 0.0, "patience": 1}, {"keep_axes": (0, 2)}, {"probe_nodes": 1},
-    {"warm_start": False},
+    {"warm_start": False}, {"stall_tol": 0.5},
 ]))
 def test_every_option_setting_stays_exact(p, opts):
     sol = solve(p, "bnb", **opts)
@@ -124,6 +124,7 @@ def test_integer_costs_are_detected():
     ({"bogus": 1}, "bogus"), ({"max_nodes": 0}, "max_nodes"), ({"patience": 0}, "patience"),
     ({"step0": 0.0}, "step0"), ({"deflect": 1.0}, "deflect"), ({"max_iter": -1}, "max_iter"),
     ({"keep_axes": (1, 1)}, "keep_axes"), ({"keep_axes": (0, 7)}, "keep_axes"),
+    ({"stall_tol": 1.0}, "stall_tol"),
 ])
 def test_bad_options_are_named(opts, match):
     p = AssignmentProblem.dense(np.ones((3, 3, 3)))

@@ -39,6 +39,10 @@ scale, halved after ``patience`` iterations without a better bound, the ascent e
 below ``step_min``; ``deflect`` (0.5): share of the previous direction kept;
 ``recover_every`` (1): N = 3 primal recovery every k iterations (0: never);
 ``warm_start`` (True): each Hungarian solve starts from the previous potentials;
+``stall_tol`` (0: off): leave the ascent for the final search when the bound gained
+less than this share of the gap since the last short search (0.02 trims the slowest
+draws a little, measured; off by default because an early search on weaker
+multipliers can run into the fallback);
 ``keep_axes`` (None: the two largest axes); ``fallback`` (True).  The defaults were
 tuned on paper-002 problems and random 3-AP with n <= 10
 (``benchmarks/sd_scaling.py``).
@@ -86,6 +90,7 @@ DEFAULTS: dict[str, Any] = {
     "max_iter": 100, "probe_every": 15, "probe_nodes": 200, "max_nodes": 200_000,
     "step0": 2.0, "patience": 10, "step_min": 1e-3, "keep_axes": None, "fallback": True,
     "deflect": 0.5, "recover_every": 1, "warm_start": True,
+    "stall_tol": 0.0,
 }
 
 
@@ -175,6 +180,10 @@ def _parse(extra: dict[str, Any]) -> dict[str, Any]:
         raise InvalidProblemError(f"option deflect must be in [0, 1), got {p['deflect']!r}")
     p["fallback"] = bool(p["fallback"])
     p["warm_start"] = bool(p["warm_start"])
+    p["stall_tol"] = float(p["stall_tol"])
+    if not 0.0 <= p["stall_tol"] < 1.0:
+        raise InvalidProblemError(f"option stall_tol must be in [0, 1), got "
+                                  f"{p['stall_tol']!r}")
     return p
 
 
@@ -219,7 +228,7 @@ class BranchBoundBackend(Backend):
             inp.axis_of, inp.ptr, inp.lst, inp.int_costs, TOL, inp.y0, p["max_iter"],
             p["probe_every"], probe_nodes, p["max_nodes"], p["step0"], p["patience"],
             p["step_min"], p["deflect"], p["recover_every"], n3, off_c, n_c,
-            p["warm_start"])
+            p["warm_start"], p["stall_tol"])
         dt = time.perf_counter() - t0
         params = {k: v for k, v in p.items()}
         params.update(keep_axes=[inp.a, inp.b], tol=TOL)

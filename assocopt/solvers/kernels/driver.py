@@ -91,7 +91,8 @@ INFEASIBLE = 2     # the kept axes admit no assignment
 @njit(cache=True)
 def solve(G, pa, pb, c, relaxed, a, b, off_a, off_b, na, nb, plain, axis_of, ptr, lst,
           int_costs, tol, y0, max_iter, probe_every, probe_budget, budget,
-          lam0, patience, lam_min, deflect, recover_every, n3, off_c, n_c, warm_start):
+          lam0, patience, lam_min, deflect, recover_every, n3, off_c, n_c, warm_start,
+          stall_tol):
     """Subgradient ascent on ``L(y)`` with periodic DFS probes, then a final DFS.
 
     Returns ``(outcome, best_sel, best_len, ub, bound, iterations, nodes)``.
@@ -112,6 +113,7 @@ def solve(G, pa, pb, c, relaxed, a, b, off_a, off_b, na, nb, plain, axis_of, ptr
     best_len = -1
     ub = INF
     best_L = -INF
+    L_probe = -INF
     lam = lam0
     since = 0
     nodes = 0
@@ -180,6 +182,9 @@ def solve(G, pa, pb, c, relaxed, a, b, off_a, off_b, na, nb, plain, axis_of, ptr
         if best_L >= improve_limit(ub, int_costs, tol):
             return PROVEN, best_sel, best_len, ub, best_L, it, nodes
         if probe_every > 0 and (it - 1) % probe_every == 0:
+            if it > 1 and ub < INF and best_L - L_probe < stall_tol * (ub - best_L):
+                break                     # the bound has stopped moving: search now
+            L_probe = best_L
             base = reduced(G, c, ybest, rp, ptr, lst, axis_of)
             sptr, slst = sort_lists(ptr, lst, rp,
                                     improve_limit(ub, int_costs, tol) - base)
