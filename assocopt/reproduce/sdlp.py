@@ -27,6 +27,7 @@ from ..api import solve
 from ..formulation import build_model
 from ..problem import AssignmentProblem
 from ..solution import Solution, Status
+from ..solvers.greedy import take_in_order
 
 __all__ = ["LPResult", "lp_relaxation", "lp_relaxations", "solve_with_fixing", "greedy_cover",
            "reduced_costs"]
@@ -61,23 +62,8 @@ def reduced_costs(prob: AssignmentProblem, u: np.ndarray) -> np.ndarray:
 
 def greedy_cover(prob: AssignmentProblem, order: np.ndarray) -> np.ndarray | None:
     """Candidates taken in ``order`` while they fit; None if no exact cover results."""
-    T = prob.tuples
-    rows = np.where(T > 0, T - 1 + prob.row_offsets[None, :], -1)
-    covered = np.zeros(prob.n_rows + 1, dtype=bool)
-    chosen, remaining = [], prob.n_rows
-    if remaining == 0:
-        return np.zeros(0, dtype=np.int64)
-    for k in order.tolist():
-        r = rows[k]
-        if covered[r].any():
-            continue
-        covered[r] = True
-        covered[-1] = False
-        chosen.append(k)
-        remaining -= int((r >= 0).sum())
-        if remaining == 0:
-            return np.array(sorted(chosen), dtype=np.int64)
-    return None
+    chosen, covered = take_in_order(prob, order)
+    return chosen if covered.all() else None
 
 
 def lp_relaxation(prob: AssignmentProblem) -> LPResult | None:

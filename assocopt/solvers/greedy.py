@@ -18,22 +18,31 @@ from ..problem import AssignmentProblem
 from ..solution import Status
 from .base import Backend, RawResult, SolveOptions, register
 
-__all__ = ["GreedyBackend", "greedy_select"]
+__all__ = ["GreedyBackend", "greedy_select", "take_in_order"]
 
 
 def greedy_select(problem: AssignmentProblem) -> tuple[np.ndarray, np.ndarray]:
-    """Greedy selection; returns (selected positions, covered-row mask).
+    """Greedy selection; returns (selected positions, covered-row mask)."""
+    order = np.lexsort((np.arange(problem.n_candidates), problem.costs, problem.slack))
+    return take_in_order(problem, order)
+
+
+def take_in_order(problem: AssignmentProblem, order: np.ndarray
+                  ) -> tuple[np.ndarray, np.ndarray]:
+    """Candidates taken in ``order`` while they fit: (selected positions, sorted, and
+    the covered-row mask); stops once every row is covered.
 
     The sequential scan is inherent to the rule; its per-candidate work is a few
     array lookups on the precomputed row indices (no model is built).
     """
     T = problem.tuples
     rows = np.where(T > 0, T - 1 + problem.row_offsets[None, :], -1)
-    order = np.lexsort((np.arange(len(T)), problem.costs, problem.slack))
     covered = np.zeros(problem.n_rows + 1, dtype=bool)   # last slot absorbs the -1 rows
     chosen = []
     remaining = problem.n_rows
-    for k in order.tolist():
+    for k in np.asarray(order).tolist():
+        if remaining == 0:
+            break
         r = rows[k]
         if covered[r].any():
             continue
@@ -41,8 +50,6 @@ def greedy_select(problem: AssignmentProblem) -> tuple[np.ndarray, np.ndarray]:
         covered[-1] = False
         chosen.append(k)
         remaining -= int((r >= 0).sum())
-        if remaining == 0:
-            break
     return np.array(sorted(chosen), dtype=np.int64), covered[:-1]
 
 
