@@ -55,7 +55,7 @@ from .errors import AssocoptError
 
 __all__ = ["Experiment", "PerMethod", "ResultStore", "run_experiment", "trial_seed",
            "setting_key", "summarise", "paired_differences", "StoreMismatchError",
-           "TrialError",
+           "TrialError", "run_all", "report_records",
            "association_metrics"]
 
 SCHEMA_VERSION = 2
@@ -535,6 +535,34 @@ def paired_differences(store: str | Path | ResultStore, exp: Experiment, metric:
 
 
 # ------------------------------------------------------------------------- metrics
+def run_all(exps: Sequence[Experiment], out: str | Path, *, workers: int = 1,
+            executor: Any = None, progress: bool = False) -> dict[str, dict[str, Any]]:
+    """Run (or resume) every experiment into ``out/<name>.sqlite``: the loop each paper
+    reproduction shares.  Returns each experiment's wall time and run statistics."""
+    out = Path(out)
+    out.mkdir(parents=True, exist_ok=True)
+    timing: dict[str, dict[str, Any]] = {}
+    for exp in exps:
+        t0 = time.perf_counter()
+        stats = run_experiment(exp, out / f"{exp.name}.sqlite", workers=workers,
+                               executor=executor, progress=progress)
+        timing[exp.name] = {"wall_s": time.perf_counter() - t0, **stats}
+    return timing
+
+
+def report_records(rows: Iterable[dict[str, Any]], exp: Experiment,
+                   setting_keys: Sequence[str]) -> list[dict[str, Any]]:
+    """Summary rows shaped for a report: tagged with the experiment's part, the
+    setting cut to ``setting_keys``, and whether the metric is volatile (timing)."""
+    out = []
+    for r in rows:
+        r["experiment"] = exp.params["experiment"]
+        r["setting"] = {k: v for k, v in r["setting"].items() if k in setting_keys}
+        r["volatile"] = r["metric"] in exp.volatile
+        out.append(r)
+    return out
+
+
 def association_metrics(chosen: Iterable[Sequence[int]], true_partition: Iterable[Sequence[int]],
                         true_targets: Iterable[Sequence[int]]) -> dict[str, float]:
     """The two correct-association rates (SPEC.md 5; defined once, used everywhere).

@@ -307,28 +307,19 @@ def run(runs: int, workers: int, seed: int, out, *, progress: bool = False,
     """
     from pathlib import Path
 
-    from ..experiments import paired_differences, run_experiment, summarise
+    from ..experiments import paired_differences, report_records, run_all, summarise
 
     out = Path(out)
-    out.mkdir(parents=True, exist_ok=True)
     exps = experiments(runs, seed, options, parts)
+    timing = run_all(exps, out, workers=workers, executor=executor, progress=progress)
     records: list[dict[str, Any]] = []
-    timing: dict[str, Any] = {}
     for exp in exps:
         store = out / f"{exp.name}.sqlite"
-        t0 = time.perf_counter()
-        stats = run_experiment(exp, store, workers=workers, executor=executor,
-                               progress=progress)
-        timing[exp.name] = {"wall_s": time.perf_counter() - t0, **stats}
-        part = exp.params["experiment"]
         paired = []
         for metric in ("tuple_rate", "partition_correct"):
             paired += paired_differences(store, exp, metric, "pattipati")
-        for r in summarise(store, exp, include_volatile=True) + paired:
-            r["experiment"] = part
-            r["setting"] = {k: v for k, v in r["setting"].items()
-                            if k in ("sigma_mrad", "d", "M")}
-            r["volatile"] = r["metric"] in exp.volatile
+        rows = summarise(store, exp, include_volatile=True) + paired
+        for r in report_records(rows, exp, ("sigma_mrad", "d", "M")):
             r["paired"] = " - " in r["metric"]
             records.append(r)
     summary = {

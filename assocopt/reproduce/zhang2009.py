@@ -36,7 +36,7 @@ import numpy as np
 from ..api import choose_solver
 from ..decide.md2da import gate_threshold, md_2da
 from ..decide.truncation import TruncationOptions, md_nd
-from ..experiments import Experiment, run_experiment, summarise
+from ..experiments import Experiment, report_records, run_all, summarise
 from ..group_matching import MeasureParams, correct_match_rate, matching_matrix, pair_components
 from ..problem import AssignmentProblem
 from ..scenarios.zhang2009 import OURS, PAPER, Zhang2009
@@ -276,22 +276,12 @@ def run(runs: int, workers: int, seed: int, out, *, progress: bool = False,
     ``echo``.  Returns the summary dict.
     """
     out = Path(out)
-    out.mkdir(parents=True, exist_ok=True)
     exps = experiments(runs, seed, options, parts)
+    timing = run_all(exps, out, workers=workers, executor=executor, progress=progress)
     records: list[dict[str, Any]] = []
-    timing: dict[str, Any] = {}
     for exp in exps:
-        store = out / f"{exp.name}.sqlite"
-        t0 = time.perf_counter()
-        stats = run_experiment(exp, store, workers=workers, executor=executor,
-                               progress=progress)
-        timing[exp.name] = {"wall_s": time.perf_counter() - t0, **stats}
-        part = exp.params["experiment"]
-        for r in summarise(store, exp, include_volatile=True):
-            r["experiment"] = part
-            r["setting"] = {k: v for k, v in r["setting"].items()
-                            if k in ("sweep", "f", "p_d", "k")}
-            r["volatile"] = r["metric"] in exp.volatile
+        rows = summarise(out / f"{exp.name}.sqlite", exp, include_volatile=True)
+        for r in report_records(rows, exp, ("sweep", "f", "p_d", "k")):
             r["method_is_ours"] = r["method"] not in PAPER_METHODS
             records.append(r)
     paired = []
