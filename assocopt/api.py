@@ -2,7 +2,6 @@
 
 from __future__ import annotations
 
-import functools
 import math
 import time
 from typing import Any
@@ -13,7 +12,7 @@ from .errors import InvalidProblemError, SolverCapabilityError
 from .formulation import RELAXATIONS
 from .problem import AssignmentProblem, index_label
 from .solution import Solution, Status
-from .solvers.base import Backend, RawResult, SolveOptions, get_backend
+from .solvers.base import Backend, RawResult, SolveOptions, get_backend, module_installed
 
 __all__ = ["solve", "choose_solver", "BNB_MAX_CANDIDATES"]
 
@@ -49,10 +48,8 @@ def _bnb_usable(problem: AssignmentProblem) -> bool:
     return _numba_installed() and sum(kept_sizes(problem)) <= BNB_MAX_KEPT
 
 
-@functools.lru_cache(maxsize=None)
 def _numba_installed() -> bool:
-    """Cached: looking a package up costs tens of microseconds, a small solve ~300."""
-    return get_backend("bnb").is_available()
+    return module_installed("numba")
 
 
 def solve(problem: AssignmentProblem, solver: str = "auto", *, relax: str | None = None,

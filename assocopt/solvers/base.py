@@ -84,6 +84,17 @@ def _distribution_version(dist: str) -> str:
         return ""
 
 
+@functools.lru_cache(maxsize=None)
+def module_installed(module: str) -> bool:
+    """Whether ``module`` can be imported, looked up once per process (``find_spec``
+    costs tens of microseconds, a small solve a few hundred): for hot paths such as
+    ``auto``'s choice; :meth:`Backend.is_available` looks afresh each time."""
+    try:
+        return importlib.util.find_spec(module) is not None
+    except (ImportError, ValueError):
+        return False
+
+
 class Backend:
     """Base class of the back ends.  Subclasses set the class attributes and ``solve``.
 

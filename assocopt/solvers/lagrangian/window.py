@@ -9,7 +9,6 @@ grows windows is :meth:`~.backend._LagrangianBase._close_gap`.
 
 from __future__ import annotations
 
-import functools
 import math
 import time
 from typing import Any
@@ -18,7 +17,7 @@ import numpy as np
 import scipy.sparse as sp
 
 from ...problem import AssignmentProblem
-from ..base import SolveOptions
+from ..base import SolveOptions, module_installed
 from .ascent import _State
 from .options import OPT_TOL
 
@@ -51,18 +50,8 @@ def _grow(n: int, integer: bool) -> int:
     return int(n * (1.25 if integer else 2.0)) + 1
 
 
-@functools.lru_cache(maxsize=None)
-def _installed(module: str) -> bool:
-    """Whether ``module`` can be imported (looked up once: find_spec is not free)."""
-    import importlib.util
-    try:
-        return importlib.util.find_spec(module) is not None
-    except (ImportError, ValueError):
-        return False
-
-
 def _has_numba() -> bool:
-    return _installed("numba")
+    return module_installed("numba")
 
 
 def _compiled_search(problem: AssignmentProblem, pos: np.ndarray, red: np.ndarray,
@@ -86,7 +75,7 @@ def _compiled_search(problem: AssignmentProblem, pos: np.ndarray, red: np.ndarra
 
 
 def _has_ortools() -> bool:
-    return _installed("ortools")
+    return module_installed("ortools")
 
 
 def _uncovered(problem: AssignmentProblem, pos: np.ndarray) -> np.ndarray:
