@@ -16,7 +16,7 @@ the problem.  A user adds a model by writing a TOML file; no code is needed::
     # any other key is a back-end option, e.g. CP-SAT's  scale = 1000
 
     [cost]                   # scenario models only
-    builder = "pattipati"    # a cost from assocopt.costs.sd_builder.COSTS
+    builder = "pattipati"    # a cost from assocopt.tracking.costs.COSTS
     [cost.params]
     normalisation = "printed"
 
@@ -135,10 +135,8 @@ class Model:
         """The S-D problem of ``scan`` with this model's cost builder (scenario models)."""
         if self.cost is None:
             raise ModelError(f"model {self.name!r} has no [cost] table (not a scenario model)")
-        from .costs.sd_builder import build_problem
-
         kw = {**dict(self.cost.get("params", {})), **params}
-        return build_problem(scan, self.cost["builder"], **kw)
+        return _cost_layer().build_problem(scan, self.cost["builder"], **kw)
 
     def to_dict(self) -> dict[str, Any]:
         """JSON-ready description of the model."""
@@ -148,6 +146,18 @@ class Model:
                 {"builder": self.cost["builder"], "params": dict(self.cost.get("params", {}))},
                 "description": self.description,
                 "path": None if self.path is None else str(self.path)}
+
+
+#: The tracking layer that owns the cost builders of scenario models.  It is found by
+#: name when a model has a ``[cost]`` table (like a plug-in), so the core never
+#: imports tracking code and loading a plain model does not load it.
+COST_LAYER = "assocopt.tracking.costs"
+
+
+def _cost_layer() -> Any:
+    import importlib
+
+    return importlib.import_module(COST_LAYER)
 
 
 # ----------------------------------------------------------------------- lookup
@@ -333,7 +343,7 @@ def _cost(raw: Any, path: Path) -> Mapping[str, Any]:
     try:
         import inspect
 
-        from .costs.sd_builder import COSTS, build_costs
+        COSTS, build_costs = _cost_layer().COSTS, _cost_layer().build_costs
     except ImportError as exc:   # pragma: no cover - the costs package ships with assocopt
         raise _fail(path, "cost.builder", f"cost builders unavailable: {exc}") from exc
     if builder not in COSTS:

@@ -28,9 +28,9 @@ import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 
-from assocopt.costs import COSTS, build_costs, tuple_geometry  # noqa: E402
-from assocopt.localise import localise, pseudo_measurements, wrap_angle  # noqa: E402
-from assocopt.scenarios.lu2013 import Lu2013  # noqa: E402
+from assocopt.tracking.costs import COSTS, build_costs, tuple_geometry  # noqa: E402
+from assocopt.tracking.localisation import localise, pseudo_measurements, wrap_angle  # noqa: E402
+from assocopt.tracking.scenarios.lu2013 import Lu2013  # noqa: E402
 
 
 def _median_ms(fn, repeat: int) -> float:

@@ -12,7 +12,7 @@ Families (every instance is solved by every method in this one process):
   unit): integrality gaps 2.3..5.7% (see :func:`crama_spieksma`);
 * random S-D tracking instances with dummies: N = 3..6 sensors, 10..50 targets,
   P_D = 0.8, Poisson false alarms, gated tuples, negative log-likelihood-ratio costs;
-* paper 002's scenario (``assocopt.scenarios.lu2013``) when that package is present:
+* paper 002's scenario (``assocopt.tracking.scenarios.lu2013``) when that package is present:
   the small problems a Monte Carlo study solves by the thousand.
 
 Methods: ``lagrangian`` (bound + heuristic), ``lagrangian-exact``, ``auto`` (``bnb``,
@@ -169,8 +169,8 @@ def tracking(rng: np.random.Generator, N: int, n_targets: int, pd: float = 0.8,
 
 def lu2013_problems(rng, M: int, pd: float, clutter: float, count: int):
     try:
-        from assocopt.costs.sd_builder import build_problem
-        from assocopt.scenarios.lu2013 import Lu2013
+        from assocopt.tracking.costs.sd_builder import build_problem
+        from assocopt.tracking.scenarios.lu2013 import Lu2013
     except ImportError:
         return None
     sc = Lu2013(n_targets=M, d=0.5, sigma_mrad=5.0, pd=pd, clutter_rate=clutter)

@@ -1,4 +1,4 @@
-"""assocopt.belief: validation, closed forms of paper 000, an independent dict-based
+"""assocopt.tracking.belief: validation, closed forms of paper 000, an independent dict-based
 oracle, and algebraic properties (hypothesis)."""
 
 from __future__ import annotations
@@ -10,7 +10,7 @@ import numpy as np
 import pytest
 from hypothesis import given, strategies as st
 
-from assocopt.belief import (InvalidMassError, MassFunction, TotalConflictError, conflict,
+from assocopt.tracking.belief import (InvalidMassError, MassFunction, TotalConflictError, conflict,
                              conflict_matrix, conflict_vectors, conjunctive,
                              conjunctive_vectors, dempster, discount, discount_vectors,
                              pignistic, pignistic_vectors, zhang_combination,

@@ -8,7 +8,7 @@ from hypothesis import given, strategies as st
 from scipy import integrate
 from scipy.stats import multivariate_normal, norm
 
-from assocopt.costs.divergence import (kld_exact, kld_gauss, kld_printed, skld_exact,
+from assocopt.tracking.costs.kld import (kld_exact, kld_gauss, kld_printed, skld_exact,
                                        skld_gauss, skld_printed)
 
 

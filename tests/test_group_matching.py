@@ -10,9 +10,9 @@ import pytest
 from hypothesis import given, strategies as st
 from scipy.stats import chi2
 
-from assocopt.belief import (MassFunction, conjunctive, discount, zhang_combination,
+from assocopt.tracking.belief import (MassFunction, conjunctive, discount, zhang_combination,
                              zhang_conflict, conflict)
-from assocopt.group_matching import (MATCH_FRAME, InvalidObservationsError, MeasureParams,
+from assocopt.tracking.group_matching import (MATCH_FRAME, InvalidObservationsError, MeasureParams,
                                      Observations, Relations, attribute_conflict,
                                      combined_masses, correct_match_rate, matching_matrix,
                                      mm_ncr, mm_tbm, mm_wa, position_belief,

@@ -7,7 +7,7 @@ import pytest
 from hypothesis import given, strategies as st
 
 from assocopt import InvalidProblemError
-from assocopt.localise import (angle_jacobian, angles, localise, localise_indexed, los_system,
+from assocopt.tracking.localisation import (angle_jacobian, angles, localise, localise_indexed, los_system,
                                pseudo_measurements, residual_jacobian, wrap_angle)
 
 S = np.array([[0.0, 20.0, 0.0], [20.0, 0.0, 0.0], [0.0, 0.0, 0.0]])   # paper, km

@@ -8,13 +8,13 @@ import numpy as np
 import pytest
 
 from assocopt import InvalidProblemError, solve
-from assocopt.costs import build_costs, build_problem
+from assocopt.tracking.costs import build_costs, build_problem
 from assocopt.errors import AssocoptError
 from assocopt.experiments import trial_seed
 from assocopt.reproduce import PAPERS, list_papers, reproduce
 from assocopt.reproduce import lu2013 as L
 from assocopt.reproduce import sdlp
-from assocopt.scenarios.lu2013 import PAPER_SENSORS_KM, Lu2013
+from assocopt.tracking.scenarios.lu2013 import PAPER_SENSORS_KM, Lu2013
 from assocopt.solvers.bruteforce import enumerate_solutions
 
 
@@ -43,7 +43,7 @@ def test_targets_on_a_line_spaced_by_d_and_truth_is_consistent():
     assert len(truth.partition()) == 4
     # shuffled: measurement i of sensor s is target labels[s][i]
     assert any(not np.array_equal(lab, np.arange(4)) for lab in truth.labels)
-    from assocopt.localise import angles
+    from assocopt.tracking.localisation import angles
     th = angles(X, np.array(PAPER_SENSORS_KM))
     for s in range(3):
         np.testing.assert_allclose(scan.meas[s], th[truth.labels[s], s], atol=1e-6)

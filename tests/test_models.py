@@ -111,7 +111,7 @@ def test_options_are_read_only():
 
 
 def test_scenario_model_builds_and_solves_a_scan():
-    from assocopt.scenarios.lu2013 import Lu2013
+    from assocopt.tracking.scenarios.lu2013 import Lu2013
 
     m = load_model("lu2013-pattipati")
     assert m.cost["builder"] == "pattipati"

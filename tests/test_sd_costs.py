@@ -9,13 +9,13 @@ import numpy as np
 import pytest
 
 from assocopt import InvalidProblemError, solve
-from assocopt.costs import (COSTS, Scan, build_costs, build_problem, candidate_tuples,
+from assocopt.tracking.costs import (COSTS, Scan, build_costs, build_problem, candidate_tuples,
                             tuple_geometry)
-from assocopt.costs.divergence import (kld_exact, kld_gauss, kld_printed, skld_exact,
+from assocopt.tracking.costs.kld import (kld_exact, kld_gauss, kld_printed, skld_exact,
                                        skld_gauss, skld_printed)
-from assocopt.costs.pattipati import measurement_constant
-from assocopt.localise import angles, localise, pseudo_measurements, wrap_angle
-from assocopt.scenarios.lu2013 import Lu2013
+from assocopt.tracking.costs.pattipati import measurement_constant
+from assocopt.tracking.localisation import angles, localise, pseudo_measurements, wrap_angle
+from assocopt.tracking.scenarios.lu2013 import Lu2013
 from assocopt.solvers.bruteforce import count_solutions
 
 S = np.array([[0.0, 20.0, 0.0], [20.0, 0.0, 0.0], [0.0, 0.0, 0.0]])

@@ -10,7 +10,7 @@ import pytest
 from hypothesis import given, settings, strategies as st
 from scipy.sparse.csgraph import minimum_spanning_tree
 
-from assocopt.decide.truncation import (MIDDLE_RULES, ORDERINGS, TIE_BREAKS,
+from assocopt.tracking.decide.truncation import (MIDDLE_RULES, ORDERINGS, TIE_BREAKS,
                                         TRAVERSED_READINGS, VISITED_READINGS,
                                         TruncationOptions, coarse_truncation,
                                         fine_truncation, md_nd, single_linkage_order, truncate)

@@ -1,10 +1,9 @@
-"""Cost builders: paper 002's Pattipati, KLD and SKLD costs (printed, exact, joint).
+"""Moved: the S-D cost builders (Pattipati, KLD/SKLD) live in :mod:`assocopt.tracking.costs`.
 
-See :mod:`assocopt.costs.sd_builder` for the pipeline and :data:`COSTS` for the names.
+This module only keeps the old import path ``assocopt.costs`` working (for users' code);
+the project itself imports from the new place.
 """
 
-from .sd_builder import (COSTS, PRINTED_COSTS, Scan, SDCosts, build_costs, build_problem,
-                         candidate_tuples, tuple_costs, tuple_geometry)
+from .._moved import alias
 
-__all__ = ["COSTS", "PRINTED_COSTS", "Scan", "SDCosts", "build_costs", "build_problem",
-           "candidate_tuples", "tuple_costs", "tuple_geometry"]
+alias(__name__, "assocopt.tracking.costs", {"divergence": "kld"})

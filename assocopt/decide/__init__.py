@@ -1,14 +1,9 @@
-"""Decision stages: turn matching measures into association relations.
+"""Moved: the decision rules (MD-ND truncation, MD-2DA) live in :mod:`assocopt.tracking.decide`.
 
-* :mod:`.truncation` -- paper 000's observation-sequence truncation ("MD-ND");
-* :mod:`.md2da` -- paper 000's 2-D assignment baseline ("MD-2DA") as an
-  optimisation model solved by any back end.
+This module only keeps the old import path ``assocopt.decide`` working (for users' code);
+the project itself imports from the new place.
 """
 
-from .md2da import MD2DAResult, gate_threshold, md_2da, md_2da_problem
-from .truncation import (TruncationOptions, TruncationResult, coarse_truncation,
-                         fine_truncation, md_nd, single_linkage_order, truncate)
+from .._moved import alias
 
-__all__ = ["TruncationOptions", "TruncationResult", "single_linkage_order",
-           "coarse_truncation", "fine_truncation", "truncate", "md_nd",
-           "MD2DAResult", "md_2da", "md_2da_problem", "gate_threshold"]
+alias(__name__, "assocopt.tracking.decide")

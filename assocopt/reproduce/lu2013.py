@@ -32,9 +32,9 @@ from typing import Any, Mapping, Sequence
 import numpy as np
 
 from ..api import solve
-from ..costs.sd_builder import COSTS, build_costs, build_problem
+from ..tracking.costs.sd_builder import COSTS, build_costs, build_problem
 from ..experiments import Experiment, association_metrics
-from ..scenarios.lu2013 import PAPER, Lu2013
+from ..tracking.scenarios.lu2013 import PAPER, Lu2013
 from ..problem import AssignmentProblem
 from ..solution import Status
 from ..solvers.bruteforce import enumerate_solutions

@@ -17,7 +17,7 @@ Four experiments, each with its own results store ``OUT/zhang2009-*.sqlite``:
                  pi = 0 E0.8) at three noise levels.
 
 Every method of a trial decides on the same simulated run (paired comparison).
-The metric is :func:`~assocopt.group_matching.correct_match_rate` (P_c, SPEC.md 5)
+The metric is :func:`~assocopt.tracking.group_matching.correct_match_rate` (P_c, SPEC.md 5)
 and ``all_correct`` (the run's relations entirely right); timings are volatile
 metrics (seconds per decision, the matching measures excluded).
 """
@@ -34,12 +34,12 @@ from typing import Any, Mapping, Sequence
 import numpy as np
 
 from ..api import choose_solver
-from ..decide.md2da import gate_threshold, md_2da
-from ..decide.truncation import TruncationOptions, md_nd
+from ..tracking.decide.md2da import gate_threshold, md_2da
+from ..tracking.decide.truncation import TruncationOptions, md_nd
 from ..experiments import Experiment, report_records, run_all, summarise
-from ..group_matching import MeasureParams, correct_match_rate, matching_matrix, pair_components
+from ..tracking.group_matching import MeasureParams, correct_match_rate, matching_matrix, pair_components
 from ..problem import AssignmentProblem
-from ..scenarios.zhang2009 import OURS, PAPER, Zhang2009
+from ..tracking.scenarios.zhang2009 import OURS, PAPER, Zhang2009
 
 __all__ = ["W", "R", "PAPER_TABLE1", "PAPER_CLAIMS", "DEFAULTS", "METHODS", "experiments",
            "trial", "parameters", "run", "render_tables", "make_figures"]

@@ -1,5 +1,9 @@
-"""Seeded scenario simulators, one per paper experiment (measurements + ground truth)."""
+"""Moved: the simulated scenarios of the papers live in :mod:`assocopt.tracking.scenarios`.
 
-from .lu2013 import Lu2013, Truth
+This module only keeps the old import path ``assocopt.scenarios`` working (for users' code);
+the project itself imports from the new place.
+"""
 
-__all__ = ["Lu2013", "Truth"]
+from .._moved import alias
+
+alias(__name__, "assocopt.tracking.scenarios")

@@ -27,10 +27,10 @@ from typing import Sequence
 import numpy as np
 from numpy.typing import ArrayLike
 
-from ..errors import InvalidProblemError
-from ..localise import localise_indexed, pseudo_measurements, wrap_angle
-from ..problem import AssignmentProblem
-from . import divergence as dv
+from ...errors import InvalidProblemError
+from ..localisation import localise_indexed, pseudo_measurements, wrap_angle
+from ...problem import AssignmentProblem
+from . import kld as dv
 from .pattipati import NORMALISATIONS, constant_terms
 
 __all__ = ["Scan", "COSTS", "PRINTED_COSTS", "candidate_tuples", "TupleGeometry",

@@ -30,8 +30,8 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..errors import InvalidProblemError
-from ..localise import wrap_angle
+from ...errors import InvalidProblemError
+from ..localisation import wrap_angle
 
 __all__ = ["NORMALISATIONS", "measurement_constant", "dummy_constant",
            "constant_terms", "mahalanobis_data"]

@@ -1,0 +1,11 @@
+"""Tracking code built on the core: everything here may import the core, never the reverse.
+
+* :mod:`.localisation` -- bearing geometry and least-squares localisation;
+* :mod:`.costs` -- S-D cost builders (Pattipati's likelihood ratio, KLD/SKLD);
+* :mod:`.belief` -- belief (mass) functions and combination rules;
+* :mod:`.group_matching` -- matching measures between two sensors' group observations;
+* :mod:`.decide` -- decision rules (MD-ND truncation, MD-2DA);
+* :mod:`.scenarios` -- the simulated scenarios of the papers (Lu 2013, Zhang 2009).
+
+Nothing is imported here, so ``import assocopt.tracking.costs`` loads only what it needs.
+"""

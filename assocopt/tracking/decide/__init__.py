@@ -1,0 +1,14 @@
+"""Decision stages: turn matching measures into association relations.
+
+* :mod:`.truncation` -- paper 000's observation-sequence truncation ("MD-ND");
+* :mod:`.md2da` -- paper 000's 2-D assignment baseline ("MD-2DA") as an
+  optimisation model solved by any back end.
+"""
+
+from .md2da import MD2DAResult, gate_threshold, md_2da, md_2da_problem
+from .truncation import (TruncationOptions, TruncationResult, coarse_truncation,
+                         fine_truncation, md_nd, single_linkage_order, truncate)
+
+__all__ = ["TruncationOptions", "TruncationResult", "single_linkage_order",
+           "coarse_truncation", "fine_truncation", "truncate", "md_nd",
+           "MD2DAResult", "md_2da", "md_2da_problem", "gate_threshold"]
