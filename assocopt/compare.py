@@ -28,6 +28,7 @@ from typing import Any, Callable, Iterable, Sequence, TextIO
 
 from .errors import AssocoptError, SolverCapabilityError
 from .problem import AssignmentProblem
+from .progress import Progress
 
 __all__ = ["Method", "CompareResult", "compare", "resolve_methods", "TOLERANCE", "COLUMNS"]
 
@@ -133,40 +134,6 @@ def _run_one(problem: AssignmentProblem, method: Method, repeat: int) -> dict[st
     return _row(problem, method, best)
 
 
-class _Progress:
-    """tqdm when installed, else a one-line counter on stderr."""
-
-    def __init__(self, total: int, enabled: bool, stream: TextIO) -> None:
-        self.total, self.done, self.stream, self.bar = total, 0, stream, None
-        self.enabled = enabled
-        if enabled:
-            try:
-                from tqdm import tqdm
-                self.bar = tqdm(total=total, file=stream, unit="run", leave=False)
-            except ImportError:
-                self.bar = None
-
-    def step(self, label: str) -> None:
-        self.done += 1
-        if not self.enabled:
-            return
-        if self.bar is not None:
-            self.bar.set_postfix_str(label[:40], refresh=False)
-            self.bar.update(1)
-        else:
-            self.stream.write(f"\rcompare {self.done}/{self.total} {label[:50]:<50}")
-            self.stream.flush()
-
-    def close(self) -> None:
-        if not self.enabled:
-            return
-        if self.bar is not None:
-            self.bar.close()
-        else:
-            self.stream.write("\r" + " " * 70 + "\r")
-            self.stream.flush()
-
-
 def _load(item: Any, fmt: str, instance: Any) -> AssignmentProblem:
     if isinstance(item, AssignmentProblem):
         return item
@@ -206,7 +173,8 @@ def compare(instances: Iterable[Any], *, solvers: Sequence[str] | None = None,
     if progress is None:
         progress = bool(getattr(sys.stderr, "isatty", lambda: False)()) and \
             len(problems) * len(methods) > 1
-    bar = _Progress(len(problems) * len(methods), progress, sys.stderr)
+    bar = Progress(len(problems) * len(methods), progress, "compare", unit="run",
+                   stream=sys.stderr, leave=False)
     rows = []
     try:
         for p in problems:
@@ -215,7 +183,7 @@ def compare(instances: Iterable[Any], *, solvers: Sequence[str] | None = None,
                 rows.append(row)
                 if on_row is not None:
                     on_row(row)
-                bar.step(f"{p.name} {m.label}")
+                bar.update(1, f"{p.name} {m.label}")
     finally:
         bar.close()
     return CompareResult(rows, [m.label for m in methods])
@@ -258,8 +226,8 @@ class CompareResult:
 
     def to_records(self) -> list[dict[str, Any]]:
         """The rows, JSON-ready (non-finite numbers as strings)."""
-        from .io import _jsonable
-        return _jsonable([dict(r) for r in self.rows])
+        from .io import jsonable
+        return jsonable([dict(r) for r in self.rows])
 
     def to_json(self) -> str:
         return json.dumps(self.to_records(), indent=2, allow_nan=False)

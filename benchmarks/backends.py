@@ -16,7 +16,6 @@ import os
 import platform
 import statistics
 import sys
-import tempfile
 import time
 from pathlib import Path
 
@@ -24,7 +23,7 @@ ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))
 
 from assocopt import Status, solve  # noqa: E402
-from assocopt.io import read_instance  # noqa: E402
+from assocopt.io import read_instance, write_text_atomically  # noqa: E402
 from assocopt.solvers import registered  # noqa: E402
 
 AP = ROOT.parent / "shared" / "ap_instances"
@@ -135,10 +134,7 @@ def render(records: list[dict], solvers: list[str], time_limit: float, argv: lis
 
 def write_atomic(path: Path, text: str) -> None:
     path.parent.mkdir(parents=True, exist_ok=True)
-    fd, tmp = tempfile.mkstemp(dir=path.parent, prefix=path.name, suffix=".tmp")
-    with os.fdopen(fd, "w") as fh:
-        fh.write(text)
-    os.replace(tmp, path)
+    write_text_atomically(path, text)
 
 
 def main(argv: list[str] | None = None) -> int:

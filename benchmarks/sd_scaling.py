@@ -34,7 +34,6 @@ import os
 import platform
 import statistics
 import sys
-import tempfile
 import time
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -45,6 +44,7 @@ ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))
 
 from assocopt import AssignmentProblem, Status, solve  # noqa: E402
+from assocopt.io import write_text_atomically  # noqa: E402
 from assocopt.solvers import registered  # noqa: E402
 
 PEERS = ("highs", "scipy", "ortools-cpsat")
@@ -506,10 +506,7 @@ def targets(rows, ap_rows, other, plain, lat, lapres) -> list[str]:
 
 def write_report(path: Path, parts: list[str]) -> None:
     path.parent.mkdir(parents=True, exist_ok=True)
-    fd, tmp = tempfile.mkstemp(dir=path.parent, prefix=".bench-", suffix=".md")
-    with os.fdopen(fd, "w") as fh:
-        fh.write("\n".join(parts) + "\n")
-    os.replace(tmp, path)
+    write_text_atomically(path, "\n".join(parts) + "\n")
 
 
 # ----------------------------------------------------------------------- main

@@ -218,21 +218,38 @@ def test_compare_keeps_going_when_a_back_end_raises(monkeypatch, capsys):
 
 
 def test_compare_progress_counter_without_tqdm(monkeypatch):
-    from assocopt import compare as cmp
+    from assocopt.progress import Progress
 
     monkeypatch.setitem(sys.modules, "tqdm", None)           # as if tqdm were missing
     stream = io.StringIO()
-    bar = cmp._Progress(2, True, stream)
-    bar.step("a highs")
-    bar.step("b highs")
+    bar = Progress(2, True, "compare", unit="run", stream=stream)
+    bar.update(1, "a highs")
+    bar.update(1, "b highs")
     bar.close()
-    assert "compare 1/2 a highs" in stream.getvalue()
-    assert "compare 2/2 b highs" in stream.getvalue()
+    assert "compare: 1/2 runs" in stream.getvalue() and "a highs" in stream.getvalue()
+    assert "compare: 2/2 runs" in stream.getvalue() and "b highs" in stream.getvalue()
     quiet = io.StringIO()
-    off = cmp._Progress(2, False, quiet)
-    off.step("x")
+    off = Progress(2, False, "compare", stream=quiet)
+    off.update(1, "x")
     off.close()
     assert quiet.getvalue() == ""
+
+
+def test_compare_uses_the_shared_progress_helper(monkeypatch):
+    """compare() reports through assocopt.progress.Progress, one step per run."""
+    from assocopt import compare as cmp
+
+    seen = []
+
+    class Spy(cmp.Progress):
+        def update(self, k=1, note=""):
+            seen.append(note)
+            super().update(k, note)
+
+    monkeypatch.setattr(cmp, "Progress", Spy)
+    p = read_instance(INSTANCES / "example-3d.json")
+    cmp.compare([p], solvers=["greedy", "highs"], progress=False)
+    assert len(seen) == 2 and all(n.startswith("example-3d ") for n in seen)
 
 
 def test_compare_repeat_keeps_the_fastest_and_python_api():

@@ -13,7 +13,7 @@ from assocopt.errors import AssocoptError
 from assocopt.experiments import trial_seed
 from assocopt.reproduce import PAPERS, list_papers, reproduce
 from assocopt.reproduce import lu2013 as L
-from assocopt.reproduce import sdlp
+from assocopt import lp_fixing
 from assocopt.tracking.scenarios.lu2013 import PAPER_SENSORS_KM, Lu2013
 from assocopt.solvers.bruteforce import enumerate_solutions
 
@@ -125,14 +125,14 @@ def test_lp_fixing_is_exact_on_fractional_instances():
                          region_km=L.DEFAULTS["region_km"]).simulate(np.random.default_rng(seed))
         for m, c in build_costs(scan, ["pattipati", "skld-printed"]).items():
             p = build_problem(scan, m, costs=c)
-            lp = sdlp.lp_relaxation(p)
+            lp = lp_fixing.lp_relaxation(p)
             core = solve(p, "highs", relax="lp")
             assert lp.objective == pytest.approx(core.objective, rel=1e-9, abs=1e-9)
             assert lp.integral == core.integral
             if lp.integral:
                 continue
             found += 1
-            sol, kept = sdlp.solve_with_fixing(p, lp, "highs")
+            sol, kept = lp_fixing.solve_with_fixing(p, lp, "highs")
             ref = solve(p, "highs")
             assert kept < p.n_candidates
             # the fixing bound is valid: L(u) <= LP optimum <= ILP optimum

@@ -130,10 +130,10 @@ def _cmd_compare(args: argparse.Namespace, out: TextIO, err: TextIO) -> int:
                   format=args.format, instance=args.instance, progress=args.progress)
     fmt = "json" if args.json else "csv" if args.csv else "text"
     if args.out:
-        from ..io import _atomic_write
+        from ..io import write_text_atomically
         buf = io.StringIO()
         res.write(buf, fmt)
-        _atomic_write(Path(args.out), buf.getvalue())
+        write_text_atomically(Path(args.out), buf.getvalue())
         print(f"wrote {args.out}: {len(res.rows)} rows ({fmt})", file=out)
     else:
         res.write(out, fmt)

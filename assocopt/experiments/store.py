@@ -6,13 +6,11 @@ Written by the coordinating process only, one transaction per trial.
 from __future__ import annotations
 
 import json
-import math
 import sqlite3
 from pathlib import Path
 from typing import Any, Iterable, Mapping, Sequence
 
-import numpy as np
-
+from ..io.writers import jsonable
 from .design import SCHEMA_VERSION, Experiment, StoreMismatchError
 
 __all__ = ["ResultStore"]
@@ -94,7 +92,7 @@ class ResultStore:
             self.register_settings([skey])
         sid = self._ids[skey]
         rows = [(sid, m, int(trial),
-                 json.dumps(_jsonable(r), sort_keys=True, separators=(",", ":")), seconds)
+                 json.dumps(_metric_values(r), sort_keys=True, separators=(",", ":")), seconds)
                 for m, r in results.items()]
         self.conn.execute("BEGIN IMMEDIATE")
         try:
@@ -114,14 +112,7 @@ class ResultStore:
         return int(self.conn.execute("SELECT COUNT(*) FROM trials").fetchone()[0])
 
 
-def _jsonable(metrics: Mapping[str, Any]) -> dict[str, Any]:
-    out = {}
-    for k, v in metrics.items():
-        if isinstance(v, (bool, np.bool_)):
-            out[k] = float(v)
-        elif v is None:
-            out[k] = None
-        else:
-            f = float(v)
-            out[k] = f if math.isfinite(f) else None   # NaN/inf stored as missing
-    return out
+def _metric_values(metrics: Mapping[str, Any]) -> dict[str, Any]:
+    """Metrics as floats (booleans count as 0/1); NaN/inf stored as missing (null)."""
+    return jsonable({k: None if v is None else float(v) for k, v in metrics.items()},
+                    nonfinite="null")

@@ -39,8 +39,9 @@ so ``from assocopt.io import X`` works as before:
 :mod:`.detect`
     :data:`FORMATS`, :func:`detect_format` and :func:`read_instance`.
 :mod:`.writers`
-    Atomic writes: :func:`replace_atomically`, :func:`write_instance`,
-    :func:`write_solution`, :func:`solution_to_dict`.
+    Atomic writes: :func:`replace_atomically`, :func:`write_text_atomically`,
+    :func:`write_json_atomically`, :func:`write_instance`, :func:`write_solution`,
+    :func:`solution_to_dict`; the JSON sanitiser :func:`jsonable`.
 """
 
 from __future__ import annotations
@@ -63,8 +64,9 @@ from .json_format import (FORMAT_NAME, FORMAT_VERSION, _COMMON_KEYS,  # noqa: F4
                           _no_duplicates, _parse_constant, _read_json,
                           instance_to_json)
 from .orlib import _orlib_optimum, _read_orlib  # noqa: F401
-from .writers import (_atomic_write, _jsonable, replace_atomically,  # noqa: F401
-                      solution_to_dict, write_instance, write_solution)
+from .writers import (_atomic_write, _jsonable, jsonable, replace_atomically,  # noqa: F401
+                      solution_to_dict, write_instance, write_json_atomically,
+                      write_solution, write_text_atomically)
 
 __all__ = ["read_instance", "write_instance", "write_solution", "detect_format",
            "instance_to_json", "solution_to_dict", "FORMATS", "FORMAT_NAME",

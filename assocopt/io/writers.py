@@ -1,9 +1,11 @@
-"""Writing files atomically: instances (JSON v1) and solutions.
+"""Writing files atomically: instances (JSON v1), solutions, any text or JSON.
 
 :func:`replace_atomically` writes through a temporary file and ``os.replace``, so
-an interrupted write never leaves a partial file; :func:`write_instance` and
-:func:`write_solution` use it (through :func:`_atomic_write`).  The JSON text of
-an instance comes from :func:`~.json_format.instance_to_json`.
+an interrupted write never leaves a partial file; :func:`write_text_atomically`,
+:func:`write_json_atomically`, :func:`write_instance` and :func:`write_solution` use
+it (the one atomic writer of the project).  :func:`jsonable` is the one JSON
+sanitiser (numpy types to Python, non-finite floats to strings or ``null``).  The
+JSON text of an instance comes from :func:`~.json_format.instance_to_json`.
 """
 
 from __future__ import annotations
@@ -43,13 +45,25 @@ def replace_atomically(path: str | os.PathLike[str], write: Any) -> None:
         raise
 
 
-def _atomic_write(path: Path, text: str) -> None:
+def write_text_atomically(path: str | os.PathLike[str], text: str) -> None:
+    """Write ``text`` (UTF-8, ``\\n`` line ends) to ``path`` atomically, synced to disk."""
     def write(tmp: Path) -> None:
         with open(tmp, "w", encoding="utf-8", newline="\n") as f:
             f.write(text)
             f.flush()
             os.fsync(f.fileno())
     replace_atomically(path, write)
+
+
+#: Old private name of :func:`write_text_atomically`.
+_atomic_write = write_text_atomically
+
+
+def write_json_atomically(path: str | os.PathLike[str], obj: Any, *, indent: int | None = 1,
+                          nonfinite: str = "null") -> None:
+    """Write ``obj`` as strict JSON (through :func:`jsonable`) to ``path`` atomically."""
+    text = json.dumps(jsonable(obj, nonfinite=nonfinite), indent=indent, allow_nan=False)
+    write_text_atomically(path, text)
 
 
 def write_instance(problem: AssignmentProblem, path: str | os.PathLike[str], *,
@@ -69,28 +83,44 @@ def write_instance(problem: AssignmentProblem, path: str | os.PathLike[str], *,
                                                description=description))
 
 
-def _jsonable(v: Any) -> Any:
-    """Plain-JSON version of ``v``: numpy types converted, non-finite floats as strings."""
+def jsonable(v: Any, *, nonfinite: str = "string") -> Any:
+    """Plain-JSON version of ``v``: numpy types and tuples converted, keys made strings.
+
+    Non-finite floats become ``"nan"``/``"inf"``/``"-inf"`` (``nonfinite="string"``,
+    the instance and solution files) or ``None`` (``nonfinite="null"``: a missing
+    value, as the experiment store and the reproduction summaries record it).
+
+    >>> jsonable({"a": np.float64("inf"), "b": (1, np.int64(2))})
+    {'a': 'inf', 'b': [1, 2]}
+    >>> jsonable([float("nan"), np.bool_(True)], nonfinite="null")
+    [None, True]
+    """
+    if nonfinite not in ("string", "null"):
+        raise ValueError(f"nonfinite must be 'string' or 'null', got {nonfinite!r}")
     if isinstance(v, dict):
-        return {str(k): _jsonable(x) for k, x in v.items()}
+        return {str(k): jsonable(x, nonfinite=nonfinite) for k, x in v.items()}
     if isinstance(v, (list, tuple)):
-        return [_jsonable(x) for x in v]
+        return [jsonable(x, nonfinite=nonfinite) for x in v]
     if isinstance(v, np.ndarray):
-        return _jsonable(v.tolist())
+        return jsonable(v.tolist(), nonfinite=nonfinite)
     if isinstance(v, (bool, np.bool_)):
         return bool(v)
     if isinstance(v, (int, np.integer)):
         return int(v)
     if isinstance(v, (float, np.floating)):
         f = float(v)
-        if math.isnan(f):
-            return "nan"
-        if math.isinf(f):
-            return "inf" if f > 0 else "-inf"
-        return f
+        if math.isfinite(f):
+            return f
+        if nonfinite == "null":
+            return None
+        return "nan" if math.isnan(f) else ("inf" if f > 0 else "-inf")
     if v is None or isinstance(v, str):
         return v
     return str(v)
+
+
+#: Old private name of :func:`jsonable`.
+_jsonable = jsonable
 
 
 def solution_to_dict(solution: Solution, extra: dict[str, Any] | None = None) -> dict[str, Any]:

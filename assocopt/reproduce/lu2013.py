@@ -31,6 +31,7 @@ from typing import Any, Mapping, Sequence
 
 import numpy as np
 
+from ..io.writers import write_json_atomically
 from ..api import solve
 from ..tracking.costs.sd_builder import COSTS, build_costs, build_problem
 from ..experiments import Experiment, association_metrics
@@ -38,7 +39,7 @@ from ..tracking.scenarios.lu2013 import PAPER, Lu2013
 from ..problem import AssignmentProblem
 from ..solution import Status
 from ..solvers.bruteforce import enumerate_solutions
-from . import sdlp
+from .. import lp_fixing
 
 __all__ = ["METHODS", "PAPER_TABLES", "PAPER_FIG2_GAIN", "DEFAULTS", "experiments",
            "fig_trial", "table_trial", "D_GRID", "TABLE_GRID"]
@@ -179,7 +180,7 @@ def table_trial(setting: Mapping[str, Any], methods: Sequence[str],
     t_lp = 0.0
     if setting["ilp_strategy"] == "lp-fixing":
         t0 = time.perf_counter()
-        lps = dict(zip(probs, sdlp.lp_relaxations(list(probs.values()))))
+        lps = dict(zip(probs, lp_fixing.lp_relaxations(list(probs.values()))))
         t_lp = (time.perf_counter() - t0) / len(probs)
     out = {}
     for m, prob in probs.items():
@@ -189,12 +190,12 @@ def table_trial(setting: Mapping[str, Any], methods: Sequence[str],
     return out
 
 
-def _solve_metrics(prob, setting: Mapping[str, Any], lp: "sdlp.LPResult | None" = None,
+def _solve_metrics(prob, setting: Mapping[str, Any], lp: "lp_fixing.LPResult | None" = None,
                    t_lp: float = 0.0) -> dict[str, Any]:
     """LP relaxation statistics and the exact solution of one S-D problem.
 
-    ``ilp_strategy="lp-fixing"``: LP by HiGHS with duals (:func:`sdlp.lp_relaxation`);
-    an integral LP optimum is an ILP optimum; otherwise :func:`sdlp.solve_with_fixing`
+    ``ilp_strategy="lp-fixing"``: LP by HiGHS with duals (:func:`lp_fixing.lp_relaxation`);
+    an integral LP optimum is an ILP optimum; otherwise :func:`lp_fixing.solve_with_fixing`
     solves a small ILP through :func:`assocopt.solve` with ``solver``.
     ``ilp_strategy="full"`` (or no ``lp`` given): LP and full ILP both through
     :func:`assocopt.solve`.
@@ -217,7 +218,7 @@ def _solve_metrics(prob, setting: Mapping[str, Any], lp: "sdlp.LPResult | None" 
         t_ilp = 0.0
     else:
         if lp is not None:
-            sol, kept = sdlp.solve_with_fixing(prob, lp, setting["solver"])
+            sol, kept = lp_fixing.solve_with_fixing(prob, lp, setting["solver"])
         else:
             sol = solve(prob, setting["solver"])
             kept = prob.n_candidates
@@ -339,26 +340,10 @@ def run(runs: int, workers: int, seed: int, out, *, progress: bool = False,
     }
     text = render_tables(summary)
     summary["figures"] = make_figures(summary, out)
-    _write_json_atomic(out / "summary.json", summary)
+    write_json_atomically(out / "summary.json", summary, indent=1)
     (out / "tables.md").write_text(text)
     echo(text)
     return summary
-
-
-def _write_json_atomic(path, obj) -> None:
-    import json
-    import os
-    tmp = path.with_suffix(path.suffix + ".tmp")
-    tmp.write_text(json.dumps(obj, indent=1, sort_keys=False, default=_json_default))
-    os.replace(tmp, path)
-
-
-def _json_default(o):
-    if isinstance(o, (np.floating, np.integer)):
-        return o.item()
-    if isinstance(o, tuple):
-        return list(o)
-    raise TypeError(f"not JSON-serialisable: {type(o).__name__}")
 
 
 def _lookup(records, experiment: str, metric: str, include_volatile=False):

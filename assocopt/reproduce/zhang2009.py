@@ -24,15 +24,14 @@ metrics (seconds per decision, the matching measures excluded).
 
 from __future__ import annotations
 
-import json
 import math
-import os
 import time
 from pathlib import Path
 from typing import Any, Mapping, Sequence
 
 import numpy as np
 
+from ..io.writers import write_json_atomically
 from ..api import choose_solver
 from ..tracking.decide.md2da import gate_threshold, md_2da
 from ..tracking.decide.truncation import TruncationOptions, md_nd
@@ -304,7 +303,7 @@ def run(runs: int, workers: int, seed: int, out, *, progress: bool = False,
     }
     text = render_tables(summary)
     summary["figures"] = make_figures(summary, out)
-    _write_json_atomic(out / "summary.json", summary)
+    write_json_atomically(out / "summary.json", summary, indent=1)
     (out / "tables.md").write_text(text)
     echo(text)
     return summary
@@ -362,21 +361,6 @@ def _paired_table(summary) -> list[str]:
     return lines + [""]
 
 
-def _write_json_atomic(path: Path, obj: Any) -> None:
-    tmp = path.with_suffix(path.suffix + ".tmp")
-    tmp.write_text(json.dumps(obj, indent=1, default=_json_default))
-    os.replace(tmp, path)
-
-
-def _json_default(o: Any) -> Any:
-    if isinstance(o, (np.floating, np.integer)):
-        return o.item()
-    if isinstance(o, tuple):
-        return list(o)
-    raise TypeError(f"not JSON-serialisable: {type(o).__name__}")
-
-
-# ------------------------------------------------------------------ tables
 def _lookup(records, experiment: str, metric: str, sweep: str | None = None):
     """{(method, x): (value, runs, stderr)} with x = f, p_d or k depending on the sweep."""
     out = {}

@@ -34,7 +34,8 @@ the origin).  For ``"ils"`` the covariance is ``(G^T R^-1 G)^-1`` at the estimat
 For ``"tls"`` the residual sandwich is evaluated at the TLS estimate (first order).
 """
 
-from .estimate import COVARIANCES, METHODS, RCOND_MIN, Localisation, localise, localise_indexed
+from .estimate import (COVARIANCES, METHODS, RCOND_MIN, Localisation, localise,  # noqa: F401
+                       localise_indexed)
 from .geometry import angle_jacobian, angles, los_system, residual_jacobian, wrap_angle
 from .pseudo import PseudoMeasurements, pseudo_measurements
 
