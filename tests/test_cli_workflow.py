@@ -16,7 +16,7 @@ import pytest
 
 from assocopt import AssignmentProblem, solve
 from assocopt.cli import (EXIT_BAD_INPUT, EXIT_INFEASIBLE, EXIT_INTERNAL, EXIT_OK, main)
-from assocopt.export import export_model, solve_model_file, write_public
+from assocopt.io import export_model, solve_model_file, write_public
 from assocopt.generate import catalogue, generate, write_index
 from assocopt.io import read_instance, write_instance
 from assocopt.solvers import registered

@@ -94,7 +94,7 @@ def _add_input_args(p: argparse.ArgumentParser, formats: Sequence[str]) -> None:
 
 
 def _add_more_parsers(sub: Any, formats: Sequence[str]) -> None:
-    from ..export import CONVERT_FORMATS
+    from ..io.convert import CONVERT_FORMATS
     from ..generate import GENERATORS
 
     pm = sub.add_parser("models", help="list the named models",

@@ -35,7 +35,7 @@ def _cmd_models(args: argparse.Namespace, out: TextIO, err: TextIO) -> int:
 
 
 def _cmd_export(args: argparse.Namespace, out: TextIO, err: TextIO) -> int:
-    from ..export import export_model
+    from ..io.mps_lp import export_model
     from ..io import read_instance
 
     problem = read_instance(args.file, format=args.format, instance=args.instance)
@@ -75,7 +75,7 @@ def _cmd_generate(args: argparse.Namespace, out: TextIO, err: TextIO) -> int:
 
 
 def _cmd_convert(args: argparse.Namespace, out: TextIO, err: TextIO) -> int:
-    from ..export import convert
+    from ..io.convert import convert
 
     info = convert(args.src, args.dst, from_format=args.format, to_format=args.to_format,
                    instance=args.instance, prove=args.prove, time_limit=args.time_limit)

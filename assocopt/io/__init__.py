@@ -38,6 +38,12 @@ so ``from assocopt.io import X`` works as before:
     ``FORMAT_VERSION``.
 :mod:`.detect`
     :data:`FORMATS`, :func:`detect_format` and :func:`read_instance`.
+:mod:`.mps_lp`
+    :func:`export_model` (the ILP / LP as an MPS or LP file), :func:`solve_model_file`.
+:mod:`.public_writers`
+    :func:`write_public`: the Grundel, OR-Library and Balas-Saltzman formats.
+:mod:`.convert`
+    :func:`convert` between formats, :func:`output_format`.
 :mod:`.writers`
     Atomic writes: :func:`replace_atomically`, :func:`write_text_atomically`,
     :func:`write_json_atomically`, :func:`write_instance`, :func:`write_solution`,
@@ -68,6 +74,11 @@ from .writers import (_atomic_write, _jsonable, jsonable, replace_atomically,  #
                       solution_to_dict, write_instance, write_json_atomically,
                       write_solution, write_text_atomically)
 
+from .convert import CONVERT_FORMATS, convert, output_format  # noqa: F401,E402
+from .mps_lp import MODEL_FORMATS, export_model, solve_model_file  # noqa: F401,E402
+from .public_writers import PUBLIC_WRITERS, write_public  # noqa: F401,E402
+
 __all__ = ["read_instance", "write_instance", "write_solution", "detect_format",
            "instance_to_json", "solution_to_dict", "FORMATS", "FORMAT_NAME",
-           "FORMAT_VERSION"]
+           "FORMAT_VERSION", "export_model", "solve_model_file", "write_public", "convert",
+           "output_format", "jsonable", "write_text_atomically", "write_json_atomically"]
