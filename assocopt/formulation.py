@@ -1,6 +1,6 @@
 """ILP and LP relaxation of the S-D assignment problem as solver-neutral arrays.
 
-One binary variable ``rho_k`` per candidate tuple k (SPEC.md eq. (6)); one equality
+One binary variable ``rho_k`` per candidate tuple k (eq. (6) of paper 002); one equality
 row per real index (eq. (8)): ``sum_{k covers (s, i)} rho_k = 1``.  The LP relaxation
 replaces ``rho_k in {0, 1}`` by ``0 <= rho_k <= 1``.  Everything is built in bulk from
 the tuple array (one CSR matrix), never one call per variable; each back end turns

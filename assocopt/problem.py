@@ -1,6 +1,6 @@
 """The assignment problem: one sparse S-D cost tensor for every case.
 
-Notation (SPEC.md 002.2): there are N index sets ("axes": sensors, or rows and
+Notation (as in docs/papers/): there are N index sets ("axes": sensors, or rows and
 columns in 2-D) of sizes ``n_1 .. n_N``.  A *candidate tuple* ``(i_1, ..., i_N)``
 picks one index per axis; ``i_s = 0`` is the **dummy** (missed detection / not
 assigned) and ``1 .. n_s`` are the real indices.  A feasible solution chooses

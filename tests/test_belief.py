@@ -123,7 +123,7 @@ def test_conjunctive_matches_oracle(m1, m2):
 def test_zhang_combination_matches_oracle_and_sums_to_one(m1, m2):
     out = zhang_combination(m1, m2)
     assert _close(out.to_dict(), _oracle_zhang(m1.to_dict(), m2.to_dict()))
-    assert math.fsum(out.to_dict().values()) == pytest.approx(1.0, abs=1e-12)   # D0.3
+    assert math.fsum(out.to_dict().values()) == pytest.approx(1.0, abs=1e-12)   # sums to 1
     assert out.empty_mass == pytest.approx(zhang_conflict(m1, m2), abs=1e-12)    # eq. 11
 
 
@@ -177,7 +177,7 @@ def test_pignistic_of_total_conflict_raises():
 
 # --------------------------------------------------- paper 000 closed forms
 @given(masses(), masses())
-def test_new_conflict_equals_one_minus_betp_inner_product(m1, m2):   # D0.2
+def test_new_conflict_equals_one_minus_betp_inner_product(m1, m2):   # K = 1 - <BetP1, BetP2>
     b1, b2 = pignistic(m1), pignistic(m2)
     assert zhang_conflict(m1, m2) == pytest.approx(1 - sum(b1[w] * b2[w] for w in F3), abs=1e-12)
 
@@ -194,7 +194,7 @@ def test_new_rule_equals_smets_rule_for_singleton_focal_sets(m1, m2):
     assert zhang_conflict(m1, m2) == pytest.approx(conflict(m1, m2), abs=1e-12)
 
 
-def test_vacuous_self_conflict_is_five_sixths():   # E0.4
+def test_vacuous_self_conflict_is_five_sixths():   # ignorance counts as conflict
     v = MassFunction.vacuous(tuple("abcdef"))
     assert zhang_conflict(v, v) == pytest.approx(5 / 6)
     assert conflict(v, v) == 0.0

@@ -47,7 +47,7 @@ def test_exact_kld_is_nonnegative_and_zero_iff_equal(mu_t, v_t, mu, v):
 
 @given(st.floats(0.1, 0.99), pos, st.floats(-1, 1))
 def test_printed_27_is_negative_when_pseudo_variance_is_smaller(ratio, v, mu):
-    """E2.11: with s~ < s and equal means the printed (27) is negative."""
+    """Printed (27), not a KL divergence: negative with s~ < s and equal means."""
     assert kld_printed(mu, ratio * v, mu, v) < 0
 
 
@@ -63,7 +63,8 @@ def test_printed_forms_as_printed():
 
 
 def test_printed_27_in_the_papers_geometry():
-    """E2.11: s~ ~ 0.88-1.34 mrad for s = 1.5 mrad gives about -5.5e4 .. -4.2e5 rad^-2."""
+    """Printed (27) in the paper's geometry: s~ ~ 0.88-1.34 mrad for s = 1.5 mrad gives
+    about -5.5e4 .. -4.2e5 rad^-2."""
     s = 1.5e-3
     for st_ in (0.88e-3, 1.34e-3):
         v = kld_printed(0.0, st_ ** 2, 0.0, s ** 2)

@@ -1,5 +1,6 @@
-"""Matching measures of paper 000 (MM-NCR, MM-TBM, MM-WA) in bulk: closed forms D0.1,
-D0.3, D0.4, agreement with the one-at-a-time belief API, and relation bookkeeping."""
+"""Matching measures of paper 000 (MM-NCR, MM-TBM, MM-WA) in bulk: the chi-square
+p-value form of m^p, the sum to 1, the closed forms on {M, Mbar}, agreement with the
+one-at-a-time belief API, and relation bookkeeping."""
 
 from __future__ import annotations
 
@@ -44,7 +45,7 @@ def test_squared_mahalanobis_matches_explicit_inverse():
         assert d2[i, j] == pytest.approx(diff @ np.linalg.inv(S) @ diff, rel=1e-10, abs=1e-12)
 
 
-def test_position_belief_is_chi2_survival_function():   # D0.1
+def test_position_belief_is_chi2_survival_function():   # m^p = chi-square(2) p-value
     d2 = np.linspace(0, 30, 61)
     assert np.allclose(position_belief(d2), chi2.sf(d2, 2), rtol=1e-12, atol=0)
     assert position_belief(0.0) == 1.0
@@ -65,7 +66,7 @@ def test_ncr_masses_equal_closed_form_d04(p_m, K, r_p, r_a):
     assert m[3] == pytest.approx(pT * aT / 2, abs=1e-12)
     assert m[0] == pytest.approx(p1 * a0 + p0 * a1 + (p1 * aT + pT * a1 + p0 * aT + pT * a0) / 2
                                  + pT * aT / 2, abs=1e-12)
-    assert m.sum() == pytest.approx(1.0, abs=1e-12)                       # D0.3
+    assert m.sum() == pytest.approx(1.0, abs=1e-12)                       # sums to 1
     assert mm_ncr(p_m, K, r_p, r_a) == pytest.approx(m[1], abs=1e-15)
 
 

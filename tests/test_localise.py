@@ -7,11 +7,12 @@ import pytest
 from hypothesis import given, strategies as st
 
 from assocopt import InvalidProblemError
-from assocopt.tracking.localisation import (angle_jacobian, angles, localise, localise_indexed, los_system,
-                               pseudo_measurements, residual_jacobian, wrap_angle)
+from assocopt.tracking.localisation import (angle_jacobian, angles, localise, localise_indexed,
+                                            los_system, pseudo_measurements, residual_jacobian,
+                                            wrap_angle)
 
 S = np.array([[0.0, 20.0, 0.0], [20.0, 0.0, 0.0], [0.0, 0.0, 0.0]])   # paper, km
-X0 = np.array([12.0, 9.0, 5.0])                                        # SPEC E2.7
+X0 = np.array([12.0, 9.0, 5.0])                                        # docs/papers/lu2013.md
 SIG = 1.5e-3
 
 
@@ -64,7 +65,7 @@ def _monte_carlo(method, n=4000, seed=1):
 
 
 def test_ls_covariance_matches_spec_numbers_and_monte_carlo():
-    """SPEC E2.7: residual-Jacobian formula (3.30, 3.07, 2.04)e-4 km^2; MC agrees."""
+    """Residual-Jacobian covariance formula (3.30, 3.07, 2.04)e-4 km^2; MC agrees."""
     th = angles(X0, S)[None]
     P = localise(th, S, np.eye(2) * SIG ** 2).P[0]
     np.testing.assert_allclose(np.diag(P) * 1e4, [3.30, 3.07, 2.04], rtol=0.01)
@@ -86,7 +87,7 @@ def test_printed_jacobian_vanishes_for_the_sensor_at_the_origin():
     J = residual_jacobian(th, X0[None], S, form="printed")
     assert np.abs(J[0, 2]).max() == 0.0          # S_3 = (0, 0, 0)
     Jr = residual_jacobian(th, X0[None], S)
-    # residual form: [[0, rho], [r, 0]] approximately (E2.7)
+    # residual form: [[0, rho], [r, 0]] approximately
     d = X0 - S[2]
     rho, r = np.hypot(d[0], d[1]), np.linalg.norm(d)
     np.testing.assert_allclose(Jr[0, 2], [[0, rho], [r, 0]], atol=1e-9)
@@ -132,7 +133,7 @@ def test_pseudo_measurement_covariance_blocks_and_full_matrix():
     for s in range(3):
         np.testing.assert_allclose(pm.full[0, 2 * s:2 * s + 2, 2 * s:2 * s + 2], pm.cov[0, s],
                                    rtol=1e-12)
-    # cross-sensor blocks are not zero (E2.8) and the full matrix has rank 3
+    # cross-sensor blocks are not zero and the full matrix has rank 3
     assert np.abs(pm.full[0, 0:2, 2:4]).max() > 1e-3 * np.abs(pm.cov[0, 0]).max()
     assert np.linalg.matrix_rank(pm.full[0], tol=1e-12 * np.abs(pm.full).max()) == 3
 

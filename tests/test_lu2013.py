@@ -113,7 +113,7 @@ def test_fig_trial_metrics_and_r_convention():
     # with non-negative data terms the best solution is below the average: r_data <= 1
     for m in ("pattipati", "kld-exact", "skld-exact", "kld-joint", "skld-joint"):
         assert 0 <= res[m]["r_data"] <= 1
-    # with the printed constants (radians) all costs are negative: r_full > 1 (E2.15)
+    # with the printed constants (radians) all costs are negative: r_full > 1
     assert res["pattipati"]["r_full"] > 1
 
 

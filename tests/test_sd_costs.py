@@ -107,7 +107,7 @@ def test_noise_free_truth_has_zero_statistical_distance_and_is_optimal():
 
 
 def test_printed_kld_data_term_is_negative_for_true_tuples_in_paper_geometry():
-    """E2.11/E2.13: pseudo-measurement spread is below sigma, so (27) goes negative."""
+    """Printed (27): pseudo-measurement spread is below sigma, so (27) goes negative."""
     scan, truth = _scan(M=3, seed=5)
     c = build_costs(scan, ["kld-printed", "kld-exact"])
     true = {tuple(t) for t in truth.target_tuples().tolist()}

@@ -52,7 +52,7 @@ def test_two_pairs_example_under_every_reading(opt):
 def test_coarse_truncation_indices():
     # f = 1, .5, .2, .3, .4 -> cuts before positions 2 (f(3)=.2 < f(4)=.3) and 3
     assert coarse_truncation([.5, .2, .3, .4]) == [(0, 1), (2, 2), (3, 4)]
-    # i = 2 .. N-1 only (E0.11): v_N never starts a segment on its own
+    # i = 2 .. N-1 only (f(1) = 1 is artificial): v_N never starts a segment on its own
     assert coarse_truncation([.1, .9]) == [(0, 0), (1, 2)]
     assert coarse_truncation([.1, .2, .3]) == [(0, 0), (1, 1), (2, 3)]
     assert coarse_truncation([.9, .1]) == [(0, 2)]

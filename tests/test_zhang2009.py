@@ -9,9 +9,10 @@ import numpy as np
 import pytest
 
 from assocopt.tracking.belief import MassFunction, pignistic
-from assocopt.tracking.decide import TruncationOptions, gate_threshold, md_2da, md_2da_problem, md_nd
+from assocopt.tracking.decide import (TruncationOptions, gate_threshold, md_2da, md_2da_problem,
+                                      md_nd)
 from assocopt.tracking.group_matching import MeasureParams, matching_matrix
-from assocopt.tracking.scenarios.zhang2009 import (Zhang2009, confusion_sets, mean_nearest_distance)
+from assocopt.tracking.scenarios.zhang2009 import Zhang2009, confusion_sets, mean_nearest_distance
 
 from conftest import EXACT, installed
 

@@ -111,7 +111,7 @@ def report_records(rows: Iterable[dict[str, Any]], exp: Experiment,
 
 def association_metrics(chosen: Iterable[Sequence[int]], true_partition: Iterable[Sequence[int]],
                         true_targets: Iterable[Sequence[int]]) -> dict[str, float]:
-    """The two correct-association rates (SPEC.md 5; defined once, used everywhere).
+    """The two correct-association rates (defined once, used everywhere; docs/papers/lu2013.md).
 
     ``partition_correct``: 1 if the chosen tuples are exactly the true partition
     (targets and false-alarm singletons), else 0.

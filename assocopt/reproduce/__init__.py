@@ -26,7 +26,7 @@ __all__ = ["PAPERS", "Paper", "list_papers", "reproduce", "run"]
 
 @dataclass(frozen=True)
 class Paper:
-    """A reproducible paper: its name, SPEC.md section, title, default run count and
+    """A reproducible paper: its name, paper number, title, default run count and
     the function doing the work (``runner(runs, workers, seed, out, **kw) -> dict``)."""
 
     name: str
@@ -50,7 +50,7 @@ PAPERS: dict[str, Paper] = {
 
 
 def list_papers() -> list[dict[str, Any]]:
-    """Name, SPEC section, title and default run count of every reproducible paper."""
+    """Name, paper number, title and default run count of every reproducible paper."""
     return [{"name": p.name, "spec": p.spec, "title": p.title,
              "default_runs": p.default_runs, "page": p.page} for p in PAPERS.values()]
 

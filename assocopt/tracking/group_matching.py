@@ -1,21 +1,21 @@
-"""Matching measures between two sensors' observations of one group (paper 000, SPEC.md 000.2).
+"""Matching measures between two sensors' observations of one group (paper 000).
 
 Every observation ``z = {p, a}`` has a 2-D position ``p`` with its noise covariance
 and an attribute BBA ``a`` on the type frame (a mass vector of length ``2**T``,
 see :mod:`assocopt.belief`).  For every pair of observations the pipeline is
 
-1. position belief on ``{M, Mbar}`` (eqs. 1-2, D0.1):
+1. position belief on ``{M, Mbar}`` (eqs. 1-2, the chi-square(2) p-value):
    ``m^p(M) = exp(-d^2 / 2)`` with ``d^2`` the squared Mahalanobis distance under
-   ``Sigma_a + Sigma_b`` (R0.1; ``c = 2``, valid for 2-D positions only, E0.1);
+   ``Sigma_a + Sigma_b`` (ours: not given; ``c = 2``, valid for 2-D positions only);
 2. attribute belief (eqs. 5-6): ``m^a(M) = 1 - K``, ``m^a(Mbar) = K`` with ``K`` the
    new conflict (4) or, for MM-TBM, the traditional conflict (3);
 3. discounting by ``r_p``, ``r_a`` (eqs. 7-9);
 4. combination: the new rule (10)-(11) for **MM-NCR**, Smets' conjunctive rule for
-   **MM-TBM**; ``pi = m(M)`` (eq. 12).  **MM-WA** (R0.2) is
+   **MM-TBM**; ``pi = m(M)`` (eq. 12).  **MM-WA** (formula not printed) is
    ``pi = w_p m^p(M) + w_a m^a(M)`` on the undiscounted (1) and (5).
 
 Everything is computed for all pairs at once with the stacked-vector operations of
-:mod:`assocopt.belief` (the closed forms D0.4 are the tests' oracle).
+:mod:`assocopt.belief` (closed forms on the 2-element frame are the tests' oracle).
 
 This module also holds the relation bookkeeping shared by the decision rules
 (:class:`Relations`) and the paper's metric, :func:`correct_match_rate`.
@@ -49,8 +49,8 @@ _M, _MBAR, _THETA = 1, 2, 3
 #: weighted average.
 MEASURES = ("ncr", "tbm", "wa")
 
-#: How pi is filled for two observations of the same sensor (E0.8):
-#: ``"formula"`` applies the cross-sensor formulas ([IMPL] of SPEC.md 000.3);
+#: How pi is filled for two observations of the same sensor (paper: cross-sensor only):
+#: ``"formula"`` applies the cross-sensor formulas (our default);
 #: ``"zero"`` sets pi = 0 (same-sensor observations never look alike).
 SAME_SENSOR_READINGS = ("formula", "zero")
 
@@ -66,7 +66,7 @@ class MeasureParams:
     Attributes
     ----------
     measure : {"ncr", "tbm", "wa"}
-        MM-NCR (paper's), MM-TBM (paper's baseline), MM-WA (R0.2: formula not printed).
+        MM-NCR (paper's), MM-TBM (paper's baseline), MM-WA (formula not printed).
     r_p, r_a : float
         Reliability factors of eqs. (7)-(9) (ncr, tbm).  Paper: 1 and 0.6 in
         Experiment 1a; ``r(1,k)``, ``r(2,k)`` in 1b; not given in Experiment 2.
@@ -199,7 +199,7 @@ def _finite(values: ArrayLike, what: str) -> np.ndarray:
 
 # ------------------------------------------------------------- components
 def squared_mahalanobis(pa: ArrayLike, ca: ArrayLike, pb: ArrayLike, cb: ArrayLike) -> np.ndarray:
-    """``d^2[i, j] = (pa_i - pb_j)^T (ca_i + cb_j)^{-1} (pa_i - pb_j)`` (R0.1), in bulk.
+    """``d^2[i, j] = (pa_i - pb_j)^T (ca_i + cb_j)^{-1} (pa_i - pb_j)``, in bulk.
 
     ``pa`` (Na, 2), ``ca`` (Na, 2, 2), ``pb`` (Nb, 2), ``cb`` (Nb, 2, 2).
     """
@@ -216,8 +216,8 @@ def squared_mahalanobis(pa: ArrayLike, ca: ArrayLike, pb: ArrayLike, cb: ArrayLi
 def position_belief(d2: ArrayLike) -> np.ndarray:
     """``m^p(M) = c / (2 Gamma(1)) exp(-d^2/2)`` with ``c = 2`` (eq. 1), i.e. ``exp(-d^2/2)``.
 
-    It is the chi-square(2) survival function of ``d^2`` (D0.1).  Only valid for
-    2-D positions (E0.1).
+    It is the chi-square(2) survival function of ``d^2``.  Only valid for
+    2-D positions (for 1-D the density is unbounded at 0, for 3-D it is 0 there).
     """
     return np.exp(-0.5 * np.asarray(d2, dtype=np.float64))
 
@@ -269,7 +269,7 @@ def mm_tbm(mp_match: ArrayLike, k_traditional: ArrayLike, r_p: float, r_a: float
 
 
 def mm_wa(mp_match: ArrayLike, k_new: ArrayLike, w_p: float, w_a: float) -> np.ndarray:
-    """MM-WA (R0.2): ``pi = w_p m^p(M) + w_a m^a(M)``, undiscounted (1) and (5)."""
+    """MM-WA (ours, formula not printed): ``pi = w_p m^p(M) + w_a m^a(M)``, undiscounted."""
     return w_p * np.asarray(mp_match, np.float64) + w_a * (1.0 - np.asarray(k_new, np.float64))
 
 
@@ -289,7 +289,7 @@ def matching_matrix(obs: Observations, params: MeasureParams | None = None, *,
                     **overrides: Any) -> np.ndarray:
     """The pooled ``N_Sigma x N_Sigma`` matrix ``pi`` (paper §4), diagonal NaN (never used).
 
-    Same-sensor entries follow ``params.same_sensor`` (E0.8).  Keyword overrides
+    Same-sensor entries follow ``params.same_sensor``.  Keyword overrides
     replace fields of ``params`` (default :class:`MeasureParams`).  ``components``:
     the output of :func:`pair_components` for ``obs``, to share it between measures.
 
@@ -387,7 +387,7 @@ def true_relations(target: ArrayLike, sensor: ArrayLike) -> Relations:
 
 
 def correct_match_rate(decided: Relations, truth: Relations) -> float:
-    """Paper 000's correct matching rate P_c for one run ([IMPL], SPEC.md 5).
+    """Paper 000's correct matching rate P_c for one run (ours: the paper does not define it).
 
     Correct decided relations (matched pairs and isolated observations that are
     also true relations) divided by the number of true relations.  A run with no

@@ -6,7 +6,7 @@ Two experiments share one results store (``OUT/runs.sqlite``):
             All 4 feasible partitions are enumerated (as the paper does); per trial
             we record whether the best one is the truth, and the solution
             discrimination r (29) under two conventions (``r_data``: constants
-            dropped, the E2.15 [IMPL] convention; ``r_full``: the costs as printed).
+            dropped, since r depends on them; ``r_full``: the costs as printed).
 ``tables``  M = 5, 10, 15, 20 targets on a line, sigma = 1.5 and 5 mrad,
             d = 0.5, 1, 1.5 (Tables 1-4).  Each S-D problem is solved through
             :func:`assocopt.solve`: first its LP relaxation (HiGHS, the paper's
@@ -68,7 +68,7 @@ def run(runs: int, workers: int, seed: int, out, *, progress: bool = False,
     summary = {
         "paper": "lu2013",
         "title": "Multi-passive-sensor data association with KL / symmetric KL costs "
-                 "(Lu et al. 2013, SPEC.md paper 002)",
+                 "(Lu et al. 2013, paper 002)",
         "runs": runs, "seed": seed, "workers": workers,
         "methods": {m: COSTS[m] for m in METHODS},
         "paper_labels": PAPER_LABELS,

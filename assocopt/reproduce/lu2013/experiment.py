@@ -33,7 +33,7 @@ D_GRID = tuple(round(0.05 * i, 2) for i in range(31))        # 0 : 0.05 : 1.5
 SIGMAS = (1.5, 5.0)
 TABLE_GRID = tuple((M, s, d) for M in (5, 10, 15, 20) for s in SIGMAS for d in (0.5, 1.0, 1.5))
 
-#: Tables 1-4 of the paper (SPEC.md 002.4): PAPER_TABLES[M][label] = 6 values in the
+#: Tables 1-4 of the paper (docs/papers/lu2013.md): PAPER_TABLES[M][label] = 6 values in the
 #: column order (1.5, 0.5) (1.5, 1) (1.5, 1.5) (5, 0.5) (5, 1) (5, 1.5).
 PAPER_TABLES: dict[int, dict[str, tuple[float, ...]]] = {
     5: {"ref. [2]": (0.8268, 0.9566, 0.9806, 0.3934, 0.6354, 0.7992),
@@ -258,10 +258,10 @@ def parameters(options: Mapping[str, Any] | None = None) -> dict[str, Any]:
             "d_unit": "km",
             "sigma_same_for_both_angles": True,
             "localiser": opts["localiser"],
-            "covariance": opts["covariance"] + " (E2.7)",
-            "normalisation": opts["normalisation"] + " (E2.3)",
+            "covariance": opts["covariance"] + " (the residual Jacobian corrects (16))",
+            "normalisation": opts["normalisation"] + " (the constant of (7))",
             "r_convention": "r_data: C_best/C_ave on the costs without the constant terms "
-                            "(E2.15); r_full: on the costs as printed (radians)",
+                            "(r depends on them); r_full: on the costs as printed (radians)",
             "correct_rate_definitions": "partition_correct: whole partition right; "
                                         "tuple_rate: fraction of true target tuples found",
             "measurement_order": "shuffled per sensor",

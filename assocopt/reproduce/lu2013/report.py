@@ -154,7 +154,7 @@ def make_figures(summary: Mapping[str, Any], out) -> list[str]:
         return []
     recs = summary["records"]
     made = []
-    specs = [("fig1_r.png", "r_data", "r = C_best / C_ave, constants dropped (E2.15)",
+    specs = [("fig1_r.png", "r_data", "r = C_best / C_ave, constants dropped",
               (-0.05, 1.05)),
              ("fig1_r_full.png", "r_full", "r on the costs as printed (radians)", None),
              ("fig2_correct.png", "partition_correct", "correct association rate", None)]

@@ -13,11 +13,12 @@ Four experiments, each with its own results store ``OUT/zhang2009-*.sqlite``:
 ``table1``       decision time versus P_d: MD-ND, MD-2DA solved by the default 2-D
                  back end (scipy's linear_sum_assignment) and by HiGHS (ILP).
 ``sensitivity``  ours: MD-2DA's gate level alpha, tau = 0, and the alternative
-                 readings of truncation (dendrogram ordering E0.10, same-sensor
-                 pi = 0 E0.8) at three noise levels.
+                 readings of truncation (dendrogram ordering, same-sensor
+                 pi = 0) at three noise levels.
 
 Every method of a trial decides on the same simulated run (paired comparison).
-The metric is :func:`~assocopt.tracking.group_matching.correct_match_rate` (P_c, SPEC.md 5)
+The metric is :func:`~assocopt.tracking.group_matching.correct_match_rate` (P_c, defined in
+docs/papers/zhang2009.md)
 and ``all_correct`` (the run's relations entirely right); timings are volatile
 metrics (seconds per decision, the matching measures excluded).
 """
@@ -63,7 +64,7 @@ def run(runs: int, workers: int, seed: int, out, *, progress: bool = False,
     summary = {
         "paper": "zhang2009",
         "title": "Group member matching with position + attribute belief functions "
-                 "(Zhang et al. 2009, SPEC.md paper 000)",
+                 "(Zhang et al. 2009, paper 000)",
         "runs": runs, "seed": seed, "workers": workers,
         "methods": {m: {"measure": METHODS[m][0], "decision": METHODS[m][1],
                         "options": METHODS[m][2], "label": LABELS.get(m, m)}

@@ -14,7 +14,8 @@ from ...api import choose_solver
 from ...tracking.decide.md2da import gate_threshold, md_2da
 from ...tracking.decide.truncation import TruncationOptions, md_nd
 from ...experiments import Experiment
-from ...tracking.group_matching import MeasureParams, correct_match_rate, matching_matrix, pair_components
+from ...tracking.group_matching import (MeasureParams, correct_match_rate, matching_matrix,
+                                        pair_components)
 from ...problem import AssignmentProblem
 from ...tracking.scenarios.zhang2009 import OURS, PAPER, Zhang2009
 
@@ -35,7 +36,7 @@ PAPER_TABLE1 = {"MD-2DA": (0.0046, 0.0187, 0.0635, 0.2404, 0.6176, 0.8699),
 #: The paper's qualitative claims (figures are not in the seed).
 PAPER_CLAIMS = {
     "1a": "§5.1 text: 'MM-TBM' better than 'MM-NCR' at every f and P_d, more so at high "
-          "noise and low P_d -- labels almost certainly swapped (E0.7): the conclusion says "
+          "noise and low P_d -- labels almost certainly swapped: the conclusion says "
           "the new rule matches better than Smets' rule",
     "1b": "MM-NCR better than MM-WA for every k, and its curve flatter",
     "2": "MD-ND better than MD-2DA at every f and P_d, most clearly at low noise and low P_d",
@@ -87,7 +88,8 @@ LABELS = {"tbm+nd": "MM-TBM (truncation)", "ncr+nd": "MM-NCR / MD-ND",
           "ncr+nd-samezero": "MD-ND, same-sensor pi = 0"}
 LABELS.update({f"ncr+2da-a{a:g}": f"MD-2DA, alpha = {a:g}" for a in DEFAULTS["sensitivity_alpha"]})
 
-#: Methods as the paper defines them (MD-2DA's cost and threshold are ours, E0.12).
+#: Methods as the paper defines them (MD-2DA's cost and threshold are ours: the paper
+#: gives neither).
 PAPER_METHODS = ("tbm+nd", "ncr+nd", "wa+nd")
 MAIN_METHODS = ("tbm+nd", "ncr+nd", "ncr+2da", "ncr+2da-rect")
 TABLE1_METHODS = ("ncr+nd", "ncr+2da", "ncr+2da-highs")
@@ -216,10 +218,10 @@ def parameters(options: Mapping[str, Any] | None = None) -> dict[str, Any]:
                               f"types k+1..k+{o['confusion_size']} (mod 6)",
             "confusion_size": o["confusion_size"],
             "confusion_includes_true": o["confusion_includes_true"],
-            "noise_reference": o["noise_reference"] + " (E0.14)",
-            "covariance_in_d2": "Sigma_1i + Sigma_2j, the true noise covariances (R0.1)",
-            "same_sensor_pi": o["same_sensor"] + " (E0.8)",
-            "ordering": o["ordering"] + " (E0.10; start = first sensor-1 observation, "
+            "noise_reference": o["noise_reference"] + " (the paper's reference is ambiguous)",
+            "covariance_in_d2": "Sigma_1i + Sigma_2j, the true noise covariances (not given)",
+            "same_sensor_pi": o["same_sensor"] + " (not defined by the paper)",
+            "ordering": o["ordering"] + " (not given; start = first sensor-1 observation, "
                                         "ties lowest index)",
             "truncation_readings": TruncationOptions(ordering=o["ordering"]).as_dict(),
             "md2da_cost": o["cost"] + ": cost -pi per pair, -tau/2 per unpaired observation",
@@ -227,9 +229,10 @@ def parameters(options: Mapping[str, Any] | None = None) -> dict[str, Any]:
                                f"the chi2(2) gate of level alpha with K = 0 "
                                f"(= {gate_threshold(ncr, o['alpha']):.6g} for MM-NCR, "
                                f"r_p={o['r_p']}, r_a={o['r_a']})",
-            "mm_wa_attribute_conflict": "new conflict (4), as eq. (5) defines m^a (R0.2)",
+            "mm_wa_attribute_conflict": "new conflict (4), as eq. (5) defines m^a "
+                                        "(formula not printed)",
             "metric": "correct_rate: correct relations / true relations per run, averaged; "
-                      "all_correct: fraction of runs entirely right (SPEC.md 5)",
+                      "all_correct: fraction of runs entirely right (ours)",
             "observation_order": "shuffled per sensor",
             "ours": list(OURS) + ["f_grid", "p_d_grid", "f_fixed", "p_d_fixed", "r_p_r_a_exp2",
                                   "md2da_cost", "md2da_threshold", "metric", "ordering",

@@ -16,7 +16,7 @@ Two layers:
   vectors ``(..., 2**n)`` (numpy broadcasting), used to compute matching measures
   for every observation pair in bulk (:mod:`assocopt.group_matching`).
 
-Rules (SPEC.md 000.2):
+Rules (paper 000, docs/papers/zhang2009.md):
 
 * Smets' unnormalised conjunctive rule:
   ``m(C) = sum_{A & B = C} m1(A) m2(B)``; the conflict ``K0 = m(empty)`` (eq. 3).
@@ -24,10 +24,10 @@ Rules (SPEC.md 000.2):
   divided by ``1 - K0``; undefined (:class:`TotalConflictError`) when ``K0 = 1``.
 * Paper 000's new conflict measure (eq. 4):
   ``K = sum_{A,B} m1(A) m2(B) (1 - |A & B| / (|A| |B|))`` (disjoint or empty pairs
-  count fully), equal to ``1 - <BetP1, BetP2>`` (D0.2).
+  count fully), equal to ``1 - <BetP1, BetP2>`` (an identity we derived; tested).
 * Paper 000's new combination rule (eqs. 10-11): for ``C != empty``
   ``m(C) = sum_{A & B = C} m1(A) m2(B) |C| / (|A| |B|)``, and ``m(empty)`` is the
-  new conflict of ``m1`` and ``m2``; it sums to 1 (D0.3) and equals Smets' rule when
+  new conflict of ``m1`` and ``m2``; it sums to 1 and equals Smets' rule when
   every focal set is a singleton.
 
 Examples

@@ -1,8 +1,9 @@
 """Paper 000's conflict measure (eq. 4) and combination rule (eqs. 10-11).
 
-:func:`zhang_conflict` (``K = 1 - <BetP1, BetP2>``, D0.2) and
+:func:`zhang_conflict` (``K = 1 - <BetP1, BetP2>``) and
 :func:`zhang_combination` (the weighted, unnormalised rule whose empty-set mass is
-that conflict, erratum E0.6), for one pair of mass functions and, as ``*_vectors``
+that conflict: eq. (11) as printed says K^a, which breaks the sum to 1), for one pair
+of mass functions and, as ``*_vectors``
 / ``*_matrix`` functions, for stacked mass vectors in bulk.  Kept apart from the
 classical rules in :mod:`assocopt.belief.combination`, whose kernels it reuses.
 (The module is not called ``conflict`` so that it cannot shadow the
@@ -28,8 +29,8 @@ def zhang_conflict(m1: MassFunction, m2: MassFunction) -> float:
     """Paper 000's new conflict measure (eq. 4) between two mass functions.
 
     ``K = K0 + sum over intersecting (A, B) of m1(A) m2(B) (|A||B| - |A & B|) / (|A||B|)``;
-    equal to ``1 - <BetP1, BetP2>`` (D0.2).  Not zero for a mass function with
-    itself when it has non-singleton focal sets (E0.4).
+    equal to ``1 - <BetP1, BetP2>``.  Not zero for a mass function with
+    itself when it has non-singleton focal sets (two vacuous reports on 6 types give 5/6).
 
     >>> v = MassFunction.vacuous(tuple("abcdef"))
     >>> round(zhang_conflict(v, v), 12)   # 1 - 1/6
@@ -43,7 +44,7 @@ def zhang_combination(m1: MassFunction, m2: MassFunction) -> MassFunction:
     """Paper 000's new combination rule (eqs. 10-11), unnormalised.
 
     ``m(C) = sum_{A & B = C} m1(A) m2(B) |C| / (|A| |B|)`` for ``C`` non-empty and
-    ``m(empty) = zhang_conflict(m1, m2)`` (eq. 11 with the erratum E0.6: the conflict
+    ``m(empty) = zhang_conflict(m1, m2)`` (eq. 11 corrected, docs/papers/zhang2009.md: the conflict
     between the two combined functions).  Sums to 1; equals :func:`conjunctive`
     when every focal set is a singleton.  Commutative, not associative, so it is
     defined for two operands only.
@@ -67,7 +68,9 @@ def zhang_conflict_vectors(a: ArrayLike, b: ArrayLike) -> np.ndarray:
 
 
 def zhang_conflict_matrix(a: ArrayLike, b: ArrayLike) -> np.ndarray:
-    """New conflict ``K[i, j]`` (eq. 4) between rows of ``a`` and ``b``, via D0.2 in bulk.
+    """New conflict ``K[i, j]`` (eq. 4) between rows of ``a`` and ``b``, in bulk.
+
+    Computed as ``1 - <BetP_a, BetP_b>``.
 
     ``K = 1 - <u_i, u_j>`` with ``u = m @ P`` the (unnormalised) pignistic vectors.
     """

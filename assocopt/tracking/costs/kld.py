@@ -4,14 +4,15 @@ Argument order follows the paper: ``KLD(p(x~), p(x))`` with ``x~`` the pseudo-me
 (mean ``mu_t``, variance ``var_t``) first and the measurement density ``x`` (mean
 ``mu``, variance ``var``) second.  All functions are vectorised (numpy broadcasting).
 
-* :func:`kld_printed` -- eq. (27) **as printed**.  Not the KL divergence (E2.11): it is
+* :func:`kld_printed` -- eq. (27) **as printed**.  Not the KL divergence: it is
   negative whenever ``var_t < var`` and has units of 1/variance.
-* :func:`skld_printed` -- eq. (28) **as printed** (E2.12): the printed (27) plus its
+* :func:`skld_printed` -- eq. (28) **as printed**, not the symmetric KL either: the
+  printed (27) plus its
   swap; the variance-mismatch term is missing.
-* :func:`kld_exact`, :func:`skld_exact` -- the exact 1-D Gaussian forms (D2.2)-(D2.3).
+* :func:`kld_exact`, :func:`skld_exact` -- the exact 1-D Gaussian forms.
 * :func:`kld_gauss`, :func:`skld_gauss` -- the exact d-dimensional Gaussian forms.
 
-Never label the printed ones plain "KLD" (SPEC_TRAPS.md point 1).
+Never label the printed ones plain "KLD" (docs/papers/lu2013.md, "Corrections to the paper").
 """
 
 from __future__ import annotations
@@ -46,7 +47,7 @@ def skld_printed(mu_t: ArrayLike, var_t: ArrayLike, mu: ArrayLike, var: ArrayLik
 
 
 def kld_exact(mu_t: ArrayLike, var_t: ArrayLike, mu: ArrayLike, var: ArrayLike) -> np.ndarray:
-    """Exact ``KL(N(mu_t, var_t) || N(mu, var))`` (D2.2); always >= 0.
+    """Exact ``KL(N(mu_t, var_t) || N(mu, var))``; always >= 0.
 
     ``1/2 [var_t/var - 1 - ln(var_t/var) + (mu_t - mu)^2 / var]``
 
@@ -61,7 +62,7 @@ def kld_exact(mu_t: ArrayLike, var_t: ArrayLike, mu: ArrayLike, var: ArrayLike) 
 
 
 def skld_exact(mu_t: ArrayLike, var_t: ArrayLike, mu: ArrayLike, var: ArrayLike) -> np.ndarray:
-    """Exact symmetric KL (Jeffreys) divergence of two 1-D Gaussians (D2.3).
+    """Exact symmetric KL (Jeffreys) divergence of two 1-D Gaussians (both KL directions).
 
     ``1/2 (var_t/var + var/var_t - 2) + 1/2 (mu_t - mu)^2 (1/var + 1/var_t)``
 

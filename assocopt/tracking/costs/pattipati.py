@@ -9,7 +9,8 @@ with ``Delta_s = m_s - G_s(x_hat)`` (azimuth difference wrapped to (-pi, pi]).  
 the two parts apart: the *data term* (the statistical distance, or in (24)-(25) the
 divergence) and the *constant term* (the log-normalisation and the dummy terms).
 
-Constant conventions (E2.3), the ``normalisation`` option:
+Constant conventions (the printed normalisation of (7) is not a Gaussian's, see
+docs/papers/lu2013.md), the ``normalisation`` option:
 
 ``"printed"`` (default, reproduces the paper)
     ``norm(R) = sqrt(2 pi det R)`` as printed, no false-alarm density.  In radians this
@@ -20,7 +21,7 @@ Constant conventions (E2.3), the ``normalisation`` option:
     of the Deb et al. likelihood ratio when the scan has one (``beta_s > 0``).
 ``"none"``
     No constant at all (data term only), the convention we use for the solution
-    discrimination r (E2.15).
+    discrimination r, which depends on the constant.
 
 With ``P_D = 1`` and no false alarms the constant is the same for every feasible
 solution, so it never changes the argmin; it does change r.

@@ -3,7 +3,7 @@
 Pipeline, all vectorised over the K candidate tuples at once (no loop per tuple):
 
 1. :func:`candidate_tuples` -- every index combination (0 = dummy) allowed by the
-   detection and false-alarm model (SPEC.md 002.2, SPEC_TRAPS.md point 3):
+   detection and false-alarm model (docs/papers/lu2013.md):
 
    * the all-dummy tuple is never a candidate;
    * a tuple with a dummy in sensor s needs ``P_Ds < 1`` (with ``P_D = 1`` it is
@@ -37,15 +37,15 @@ __all__ = ["Scan", "COSTS", "PRINTED_COSTS", "candidate_tuples", "TupleGeometry"
            "tuple_geometry", "SDCosts", "tuple_costs", "build_costs", "build_problem"]
 
 #: The named cost builders: name -> what it is.  "printed" = exactly as printed in
-#: paper 002 (not true divergences, E2.11-E2.12); "exact" = (D2.2)-(D2.3) with the
+#: paper 002 (not true divergences); "exact" = the exact 1-D Gaussian forms with the
 #: independence step (26); "joint" = the exact 2-D Gaussian divergence of each
 #: sensor's [alpha, beta] pair, without (26).
 COSTS: dict[str, str] = {
     "pattipati": "eq. (7): 1/2 Delta^T R^-1 Delta with the LS position (ref. [2] of paper 002)",
-    "kld-printed": "eqs. (24)+(26)+(27) exactly as printed (not a KL divergence, E2.11)",
-    "skld-printed": "eqs. (25)+(26)+(28) exactly as printed (not the symmetric KL, E2.12)",
-    "kld-exact": "eqs. (24)+(26) with the exact 1-D Gaussian KL divergence (D2.2)",
-    "skld-exact": "eqs. (25)+(26) with the exact 1-D symmetric KL divergence (D2.3)",
+    "kld-printed": "eqs. (24)+(26)+(27) exactly as printed (not a KL divergence)",
+    "skld-printed": "eqs. (25)+(26)+(28) exactly as printed (not the symmetric KL)",
+    "kld-exact": "eqs. (24)+(26) with the exact 1-D Gaussian KL divergence",
+    "skld-exact": "eqs. (25)+(26) with the exact 1-D symmetric KL divergence",
     "kld-joint": "eq. (24) with the exact 2-D Gaussian KL of each sensor's (alpha, beta)",
     "skld-joint": "eq. (25) with the exact 2-D Gaussian symmetric KL of each sensor's "
                   "(alpha, beta)",
@@ -305,7 +305,7 @@ def tuple_costs(scan: Scan, geometry: TupleGeometry, method: str, *,
     n_real = g.n_real
     data = _data_term(g, method)
     bad = ((n_real >= 2) & ~g.valid) | ~np.isfinite(data)
-    data = np.where(n_real == 1, 0.0, data)        # false-alarm tuple: cost 0 (002.2)
+    data = np.where(n_real == 1, 0.0, data)        # false-alarm tuple: cost 0 (our convention)
     data = np.where(bad, np.inf, data)
     total = const + data
     return SDCosts(method, g.tuples, total, data, const,

@@ -1,4 +1,5 @@
-"""MD-2DA: paper 000's baseline decision as a 2-D assignment model (SPEC.md 000.4, E0.12).
+"""MD-2DA: paper 000's baseline decision as a 2-D assignment model (the paper gives its costs
+and gating, so they are ours: docs/papers/zhang2009.md).
 
 The paper compares its truncation rule with "2-D assignment on pi" but gives neither
 the cost nor the handling of unpaired observations.  Ours (recorded with every
@@ -14,7 +15,7 @@ result):
   (product of pi over matched pairs), as the alternative reading.
 * **Threshold** (:func:`gate_threshold`): ``tau`` is the matching measure of a
   pair whose position lies exactly on the chi-square(2) gate of level ``alpha``
-  (``m^p(M) = alpha``: by D0.1 ``m^p(M)`` *is* the gate's p-value) and whose
+  (``m^p(M) = alpha``: ``m^p(M) = exp(-d^2/2)`` *is* the gate's chi-square(2) p-value) and whose
   attributes agree perfectly (``K = 0``).  Every measure is non-decreasing in
   ``m^p(M)`` and in ``1 - K``, so a pair outside the position gate can never be
   matched, whatever its attributes, and pairs inside compete on pi.  Default

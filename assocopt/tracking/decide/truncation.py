@@ -1,24 +1,25 @@
-"""Observation-sequence truncation, paper 000's decision rule "MD-ND" (SPEC.md 000.3).
+"""Observation-sequence truncation, paper 000's decision rule "MD-ND" (docs/papers/zhang2009.md).
 
 Input: the pooled matching-measure matrix ``pi`` (``N x N``, similarity, diagonal
 unused) and each observation's sensor.  Three steps:
 
 A. **Sequence construction** -- single-linkage ordering of the observations,
-   giving ``v_1 .. v_N`` and ``l_1 .. l_{N-1}`` (R0.3: Prim's algorithm on the
+   giving ``v_1 .. v_N`` and ``l_1 .. l_{N-1}`` (Prim's algorithm on the
    similarity, ``l_{n-1}`` the value at which ``v_n`` joins; or the leaf order of the
-   single-linkage dendrogram, E0.10).
+   single-linkage dendrogram; the paper does not spell the ordering out).
 B. **Coarse truncation** -- ``f(1) = 1``, ``f(n) = l_{n-1}`` (eq. 13); cut just before
    ``v_i`` when ``f(i) < f(i+1)``, ``i = 2 .. N-1``.  Inside a segment ``l_{t,k}`` joins
    ``v_{t,k}`` and ``v_{t,k+1}``; the link to the previous segment is dropped.
 C. **Fine truncation** -- the paper's Steps 1-2 on each segment, literally, with the
-   readings of E0.9 as named options (:class:`TruncationOptions`).
+   readings of the fine truncation the paper leaves open as named
+   options (:class:`TruncationOptions`).
 
 Every observation ends in exactly one relation (matched pair or isolated): the
 result is a :class:`~assocopt.group_matching.Relations`, which checks it.
 
 A derived property (D, checked by the tests on random inputs under every
 combination of options): with undecided nodes isolated at the end, Step C's
-*partition* does not depend on the E0.9 readings.  It matches exactly the
+*partition* does not depend on those readings.  It matches exactly the
 cross-sensor pairs ``(v_{t,m}, v_{t,m+1})`` whose measure ``l_{t,m}`` is a strict
 local maximum of ``c^l_t`` (an end measure compared with its one neighbour; a
 two-node segment always matches when its nodes come from different sensors), and
@@ -60,7 +61,7 @@ __all__ = ["ORDERINGS", "TIE_BREAKS", "TRAVERSED_READINGS", "VISITED_READINGS",
            "MIDDLE_RULES", "TruncationOptions", "TruncationResult", "single_linkage_order",
            "coarse_truncation", "fine_truncation", "truncate", "md_nd", "check_pi"]
 
-#: Step A (E0.10): Prim order (R0.3) or single-linkage dendrogram leaf order.
+#: Step A (not spelled out by the paper): Prim order or single-linkage dendrogram leaf order.
 ORDERINGS = ("prim", "dendrogram")
 #: Ties between equal measures (Prim's next node, Step 1's largest measure): lowest
 #: or highest index first.
@@ -78,9 +79,9 @@ MIDDLE_RULES = ("first", "both")
 
 @dataclass(frozen=True)
 class TruncationOptions:
-    """The readings of SPEC.md 000.3 / E0.9-E0.10 the paper leaves open.
+    """The readings of Steps A-C the paper leaves open (docs/papers/zhang2009.md).
 
-    Defaults are SPEC.md's [IMPL] recommendations.  ``start`` is the pooled index of
+    Defaults are the readings the reproduction uses.  ``start`` is the pooled index of
     Step A's first node (``0``: the first observation of sensor 1; ignored by the
     dendrogram ordering).  Fixed readings, recorded by :meth:`as_dict`: an empty
     ``V_t`` goes back to Step 1, a single-node segment is an isolated point, and any
@@ -147,7 +148,7 @@ def single_linkage_order(pi: ArrayLike, *, start: int = 0, tie_break: str = "low
                          ordering: str = "prim") -> tuple[np.ndarray, np.ndarray]:
     """Step A: the observation sequence ``v`` and measure sequence ``l``.
 
-    ``"prim"`` (R0.3): ``v_1 = start``; each next node is the unvisited ``w``
+    ``"prim"``: ``v_1 = start``; each next node is the unvisited ``w``
     maximising ``max_{u visited} pi[u, w]``, and ``l_{n-1}`` is that maximum.
     ``"dendrogram"``: leaf order of scipy's single-linkage dendrogram on the
     dissimilarity ``max(pi) - pi``, with ``l_n`` the similarity at which ``v_n`` and
@@ -217,7 +218,7 @@ def fine_truncation(nodes: Sequence[int], measures: Sequence[float], sensor: Arr
 
     ``nodes``: ``v_{t,1} .. v_{t,n+1}`` (pooled indices); ``measures``:
     ``l_{t,1} .. l_{t,n}`` (``l_{t,k}`` between nodes k and k+1); ``sensor``: pooled
-    sensor labels.  Implements Steps 1-2 of SPEC.md 000.3 literally.
+    sensor labels.  Implements Steps 1-2 of the paper's truncation literally.
     """
     opt = options or TruncationOptions()
     c = [int(x) for x in nodes]
@@ -266,7 +267,7 @@ def fine_truncation(nodes: Sequence[int], measures: Sequence[float], sensor: Arr
         endpoints.update((a, b))
         if stop:
             break
-    for x in c:                                     # [IMPL] undecided at the end: isolated
+    for x in c:                                     # our reading: undecided at the end: isolated
         if x not in decided:
             isolate(x)
     return clusters
@@ -275,7 +276,7 @@ def fine_truncation(nodes: Sequence[int], measures: Sequence[float], sensor: Arr
 def _step2(V, m, n, L, s, all_done, opt, isolate, isolate_rest, match) -> bool:
     """Step 2 for the chosen measure ``l_m`` (1-based); True when the segment ends."""
     if not V:
-        return False                                # [IMPL] empty V_t: back to Step 1
+        return False                                # our reading: empty V_t: back to Step 1
     if len(V) == 1:
         isolate(V[0])
         return False

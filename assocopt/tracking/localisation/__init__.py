@@ -3,12 +3,12 @@
 One module per concept: :mod:`.geometry` (angles, Jacobians, line-of-sight system),
 :mod:`.estimate` (the estimators), :mod:`.pseudo` (pseudo-measurements).
 
-Conventions (SPEC.md 002.2)
+Conventions (docs/papers/lu2013.md)
 ---------------------------
 * Angles are in **radians** everywhere inside the library; positions in any length
   unit (the paper's scenarios use km).  Only scenario files and reports use mrad.
 * A sensor measures ``theta = [alpha, beta]``: **elevation first**, then azimuth.
-  ``beta = atan2(dy, dx)`` (four-quadrant, E2.1), ``alpha = atan2(dz, rho)`` with
+  ``beta = atan2(dy, dx)`` (four-quadrant), ``alpha = atan2(dz, rho)`` with
   ``rho = hypot(dx, dy)``, ``d = x - x*_s``.
 * Batches: ``K`` candidate tuples of ``N`` sensors.  ``meas`` has shape ``(K, N, 2)``;
   ``mask`` (``(K, N)`` bool) marks the sensors that contribute a real measurement
@@ -24,10 +24,10 @@ Estimators (``method=``)
     Iterated (Gauss-Newton, weighted) least squares on the angle residuals, started
     at the LS solution: the maximum-likelihood estimate under Gaussian angle noise.
 ``"tls"``
-    Total least squares of ``[H | Y]`` (errors in H as well, E2.6), unweighted.
+    Total least squares of ``[H | Y]`` (H holds noisy angles too), unweighted.
 
 Covariance (15)-(16) uses, by default, the Jacobian of the equation *residual*
-``e(m) = H(m) x - Y(m)`` with respect to the measured angles (E2.7,
+``e(m) = H(m) x - Y(m)`` with respect to the measured angles (not Y alone as (16) does,
 ``covariance="residual"``); ``covariance="printed"`` is the literal ``dY/dm`` of (16),
 kept only to show that it is wrong (it depends on the origin and is 0 for a sensor at
 the origin).  For ``"ils"`` the covariance is ``(G^T R^-1 G)^-1`` at the estimate.

@@ -104,7 +104,8 @@ def localise(meas: ArrayLike, sensors: ArrayLike, R: ArrayLike,
     method : {"ls", "ils", "tls"}
         Estimator, see the module docstring.
     covariance : {"residual", "printed"}
-        Covariance form for ``"ls"``/``"tls"`` (E2.7); ignored by ``"ils"``.
+        Covariance form for ``"ls"``/``"tls"`` (residual Jacobian or the printed dY/dm);
+        ignored by ``"ils"``.
     iterations : int
         Gauss-Newton steps for ``"ils"``.
 
@@ -174,7 +175,7 @@ def localise_indexed(meas: Sequence[ArrayLike], R: Sequence[ArrayLike], sensors:
     with 1-based indices and 0 for a dummy.  For ``method="ls"`` this is the fast path
     used by the cost builders: the per-measurement parts of ``H^T H`` and ``H^T Y`` are
     computed once per measurement and summed per tuple by gathering (no matrix per
-    tuple), and the covariance (15) with the residual Jacobian (E2.7) is assembled from
+    tuple), and the covariance (15) with the residual Jacobian is assembled from
     closed-form 3-vectors.  It agrees with :func:`localise` to rounding.
 
     Examples

@@ -65,7 +65,7 @@ def angles(points: ArrayLike, sensors: ArrayLike) -> np.ndarray:
 
 
 def angle_jacobian(points: ArrayLike, sensors: ArrayLike) -> np.ndarray:
-    """Jacobian ``d[alpha, beta]/d(x, y, z)`` (D2.1), shape ``(..., N, 2, 3)``."""
+    """Jacobian ``d[alpha, beta]/d(x, y, z)``, shape ``(..., N, 2, 3)``."""
     P = np.asarray(points, dtype=np.float64)
     S = _check_sensors(sensors)
     d = P[..., None, :] - S
@@ -145,7 +145,7 @@ def _los(m: np.ndarray, mk: np.ndarray, S: np.ndarray) -> tuple[np.ndarray, np.n
 
 def residual_jacobian(meas: np.ndarray, x: np.ndarray, sensors: np.ndarray,
                       mask: np.ndarray | None = None, form: str = "residual") -> np.ndarray:
-    """Per-sensor 2x2 Jacobian of the equation error w.r.t. ``[alpha, beta]`` (E2.7).
+    """Per-sensor 2x2 Jacobian of the equation error w.r.t. ``[alpha, beta]`` (not of Y alone).
 
     ``form="residual"``: ``d(H(m) x - Y(m))/dm`` at ``x`` (correct);
     ``form="printed"``: the literal ``dY/dm`` of eq. (16) (origin-dependent, wrong).

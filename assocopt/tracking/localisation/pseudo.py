@@ -25,7 +25,8 @@ class PseudoMeasurements:
     jac : ndarray (K, N, 2, 3)
         ``g_x(x_hat)``.
     full : ndarray (K, 2N, 2N) or None
-        The whole ``g P g^T`` with the cross-sensor blocks (E2.8), when asked for.
+        The whole ``g P g^T`` with the cross-sensor blocks (the paper keeps
+        only the diagonal blocks), when asked for.
         Its rank is at most 3 (all pseudo-measurements derive from one 3-D point).
     """
 

@@ -1,4 +1,4 @@
-"""Seeded simulator of paper 002's scenarios (Lu et al. 2013, SPEC.md 002.4).
+"""Seeded simulator of paper 002's scenarios (Lu et al. 2013, docs/papers/lu2013.md).
 
 The paper gives: three angle-only sensors at S1 = (0, 20, 0), S2 = (20, 0, 0),
 S3 = (0, 0, 0) km; angle noise sigma = 1.5 or 5 mrad; no false alarms, no missed

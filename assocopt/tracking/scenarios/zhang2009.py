@@ -1,4 +1,4 @@
-"""Seeded simulator of paper 000's group scenario (Zhang et al. 2009, SPEC.md 000.4).
+"""Seeded simulator of paper 000's group scenario (Zhang et al. 2009, docs/papers/zhang2009.md).
 
 The paper gives: 9 member targets of 6 types placed completely at random in a
 region; two sensors with the same detection probability ``P_d``; Gaussian position
@@ -16,10 +16,10 @@ Everything else is **ours** and a named parameter of :class:`Zhang2009`
 (:data:`OURS` lists them): the region (square, 100 x 100 by default; results do not
 depend on its size because the noise scales with the inter-target distance), which
 target has which type, the confusion sets (type k is confused with type k+1, the
-set containing the true type), the reading of "average minimum distance" (E0.14),
+set containing the true type), the reading of "average minimum distance" (ambiguous),
 and the order of each sensor's observations (random, so an index never reveals the
 target).  Positions are registered (no bias), and the noise covariance used in the
-Mahalanobis distance is the true one, ``sigma^2 I`` per measurement (R0.1).
+Mahalanobis distance is the true one, ``sigma^2 I`` per measurement (the paper does not say).
 
 Examples
 --------
@@ -62,7 +62,8 @@ TYPE_NAMES = tuple(f"type{k}" for k in range(1, 7))
 #: ``"cyclic"``: target k has type k mod n_types (fixed); ``"uniform"``: i.i.d. uniform.
 TYPE_ASSIGNMENTS = ("cover", "cyclic", "uniform")
 
-#: E0.14: ``"per_run"`` -- each run's mean nearest-neighbour distance of its targets;
+#: The paper's noise reference is ambiguous.  ``"per_run"`` -- each run's mean
+#: nearest-neighbour distance of its targets;
 #: ``"mean_over_runs"`` -- the expectation of that quantity (a fixed constant for the
 #: region, estimated once by a seeded Monte Carlo of 20 000 layouts).
 NOISE_REFERENCES = ("per_run", "mean_over_runs")
@@ -134,7 +135,7 @@ class Zhang2009:
     confusion_includes_true : bool
         Whether a type's confusion set contains the type itself (ours: True).
     noise_reference : str
-        See :data:`NOISE_REFERENCES` (E0.14; ours: "per_run", SPEC's [IMPL]).
+        See :data:`NOISE_REFERENCES` (the paper's reference is ambiguous; ours: "per_run").
     generator_probability : float
         Probability of attribute generator 1 (paper: 1/2).
     shuffle : bool
