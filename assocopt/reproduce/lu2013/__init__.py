@@ -26,8 +26,8 @@ from __future__ import annotations
 
 from typing import Any, Mapping, Sequence
 
-from ...io.writers import write_json_atomically
 from ...tracking.costs.sd_builder import COSTS
+from .._report import write_report
 from .experiment import (D_GRID, DEFAULTS, METHODS, OURS_PARAMS, PAPER_FIG2_GAIN,  # noqa: F401
                          PAPER_LABELS, PAPER_TABLES, PRINTED, SIGMAS, TABLE_COLUMNS, TABLE_GRID,
                          _cost_opts, _problems, _ratio, _scenario, _solve_metrics, experiments,
@@ -80,9 +80,4 @@ def run(runs: int, workers: int, seed: int, out, *, progress: bool = False,
         "records": records,
         "timing": timing,
     }
-    text = render_tables(summary)
-    summary["figures"] = make_figures(summary, out)
-    write_json_atomically(out / "summary.json", summary, indent=1)
-    (out / "tables.md").write_text(text)
-    echo(text)
-    return summary
+    return write_report(out, summary, render_tables, make_figures, echo)

@@ -29,7 +29,7 @@ from pathlib import Path
 from typing import Any, Mapping, Sequence
 
 from ...experiments import report_records, run_all, summarise
-from ...io.writers import write_json_atomically
+from .._report import write_report
 from .experiment import (DEFAULTS, LABELS, MAIN_METHODS, METHODS, PAPER_CLAIMS,  # noqa: F401
                          PAPER_METHODS, PAPER_TABLE1, TABLE1_METHODS, TABLE1_PD, VOLATILE, R, W,
                          _measure_params, _options, experiments, parameters, trial)
@@ -76,9 +76,4 @@ def run(runs: int, workers: int, seed: int, out, *, progress: bool = False,
         "paired": paired,
         "timing": timing,
     }
-    text = render_tables(summary)
-    summary["figures"] = make_figures(summary, out)
-    write_json_atomically(out / "summary.json", summary, indent=1)
-    (out / "tables.md").write_text(text)
-    echo(text)
-    return summary
+    return write_report(out, summary, render_tables, make_figures, echo)
