@@ -4,6 +4,6 @@ This module only keeps the old import path ``assocopt.group_matching`` working (
 the project itself imports from the new place.
 """
 
-from ._moved import alias
+from ._moved import reexport
 
-alias(__name__, "assocopt.tracking.group_matching")
+__getattr__ = reexport(globals(), "assocopt.tracking.group_matching")

@@ -4,6 +4,6 @@ This module only keeps the old import path ``assocopt.belief`` working (for user
 the project itself imports from the new place.
 """
 
-from .._moved import alias
+from .._moved import reexport
 
-alias(__name__, "assocopt.tracking.belief")
+__getattr__ = reexport(globals(), "assocopt.tracking.belief")

@@ -4,6 +4,6 @@ This module only keeps the old import path ``assocopt.decide`` working (for user
 the project itself imports from the new place.
 """
 
-from .._moved import alias
+from .._moved import reexport
 
-alias(__name__, "assocopt.tracking.decide")
+__getattr__ = reexport(globals(), "assocopt.tracking.decide")

@@ -86,6 +86,7 @@ def run_experiment(exp: Experiment, store: str | Path | ResultStore, *, workers:
     Examples
     --------
     >>> import tempfile, os
+    >>> from assocopt.experiments import _demo_trial
     >>> exp = Experiment("demo", [{"mu": 0.0}], ["a"], _demo_trial, runs=3, seed=1)
     >>> with tempfile.TemporaryDirectory() as d:
     ...     run_experiment(exp, os.path.join(d, "r.sqlite"))

@@ -4,6 +4,6 @@ This module only keeps the old import path ``assocopt.reproduce.sdlp`` working (
 users' code); the project itself imports from the new place.
 """
 
-from .._moved import alias
+from .._moved import reexport
 
-alias(__name__, "assocopt.lp_fixing")
+__getattr__ = reexport(globals(), "assocopt.lp_fixing")
