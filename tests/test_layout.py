@@ -252,3 +252,17 @@ def test_no_reference_to_files_the_project_does_not_ship():
                 bad.append(f"{f.relative_to(ROOT)}:{i}: {m.group(0)!r}")
     assert not bad, ("state the equation or correction in words and point to "
                      "docs/papers/NAME.md instead:\n" + "\n".join(bad[:60]))
+
+
+def test_a_plain_model_does_not_load_the_tracking_layer():
+    """The cost layer is looked up only for models with a [cost] table."""
+    import subprocess
+    import sys
+
+    code = ("import sys, assocopt.models as m; m.load_model('highs-ilp');"
+            "print(any(k.startswith('assocopt.tracking') for k in sys.modules));"
+            "m.load_model('lu2013-pattipati');"
+            "print(any(k.startswith('assocopt.tracking') for k in sys.modules))")
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
+                         cwd=ROOT, check=True).stdout.split()
+    assert out == ["False", "True"]
