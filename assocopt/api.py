@@ -2,17 +2,17 @@
 
 from __future__ import annotations
 
-import math
+import dataclasses
 import time
 from typing import Any
 
 import numpy as np
 
-from .errors import InvalidProblemError, SolverCapabilityError
-from .formulation import RELAXATIONS
+from .errors import InvalidProblemError
 from .problem import AssignmentProblem, index_label
 from .solution import Solution, Status
-from .solvers.base import Backend, RawResult, SolveOptions, get_backend, module_installed
+from .solvers.base import (Backend, RawResult, SolveOptions, check_capabilities,
+                           get_backend, module_installed)
 
 __all__ = ["solve", "choose_solver", "BNB_MAX_CANDIDATES"]
 
@@ -74,7 +74,9 @@ def solve(problem: AssignmentProblem, solver: str = "auto", *, relax: str | None
     threads : int, optional
         Threads for back ends that use them.
     **options
-        Back-end specific options (see each back end's docstring).
+        Back-end specific options, declared by each back end (``assocopt solvers
+        --options NAME``, docs/solver-options.md); an unknown one is an error.  The
+        parsed values, defaults included, are in ``Solution.info["options"]``.
 
     Returns
     -------
@@ -92,15 +94,14 @@ def solve(problem: AssignmentProblem, solver: str = "auto", *, relax: str | None
     if not isinstance(problem, AssignmentProblem):
         raise InvalidProblemError(
             f"problem must be an AssignmentProblem, got {type(problem).__name__}")
-    if relax not in RELAXATIONS:
-        raise InvalidProblemError(f"relax must be None or 'lp', got {relax!r}")
-    _check_limits(time_limit, mip_gap, threads)
+    common = SolveOptions(relax=relax, time_limit=time_limit, mip_gap=mip_gap,
+                          threads=threads, verbose=verbose)     # checks the common options
     name = choose_solver(problem, relax) if solver == "auto" else solver
     backend_cls = get_backend(name)
-    _check_capabilities(backend_cls, problem, relax)
+    check_capabilities(backend_cls, problem, relax)
     backend_cls.require()
-    opts = SolveOptions(relax=relax, time_limit=time_limit, mip_gap=float(mip_gap),
-                        threads=threads, verbose=verbose, extra=dict(options))
+    parsed = backend_cls.parse_options(options)
+    opts = dataclasses.replace(common, extra=parsed, parsed=True)
 
     missing = problem.uncovered()
     if missing:
@@ -117,31 +118,9 @@ def solve(problem: AssignmentProblem, solver: str = "auto", *, relax: str | None
     else:
         raw = backend_cls().solve(problem, opts)
     sol = _finalise(problem, backend_cls, raw, relax)
+    sol.info.setdefault("options", parsed)
     sol.times["total"] = time.perf_counter() - t0
     return sol
-
-
-def _check_limits(time_limit: float | None, mip_gap: float, threads: int | None) -> None:
-    if time_limit is not None and not (isinstance(time_limit, (int, float))
-                                       and time_limit > 0 and not math.isnan(time_limit)):
-        raise InvalidProblemError(f"time_limit must be a positive number, got {time_limit!r}")
-    if not (isinstance(mip_gap, (int, float)) and 0 <= mip_gap < math.inf):
-        raise InvalidProblemError(f"mip_gap must be a number >= 0, got {mip_gap!r}")
-    if threads is not None and not (isinstance(threads, int) and threads >= 1):
-        raise InvalidProblemError(f"threads must be a positive integer, got {threads!r}")
-
-
-def _check_capabilities(cls: type[Backend], problem: AssignmentProblem,
-                        relax: str | None) -> None:
-    if relax == "lp" and not cls.lp:
-        raise SolverCapabilityError(f"solver {cls.name!r} cannot solve LP relaxations")
-    if relax is None and not cls.integer:
-        raise SolverCapabilityError(f"solver {cls.name!r} solves LP relaxations only; "
-                                    "pass relax='lp'")
-    if cls.max_ndim is not None and problem.ndim > cls.max_ndim:
-        raise SolverCapabilityError(
-            f"solver {cls.name!r} handles problems of at most {cls.max_ndim} axes, "
-            f"this one has {problem.ndim}")
 
 
 _INTEGRAL_TOL = 1e-6
@@ -150,8 +129,9 @@ _INTEGRAL_TOL = 1e-6
 def _finalise(problem: AssignmentProblem, cls: type[Backend], raw: RawResult,
               relax: str | None) -> Solution:
     """Common post-processing: never trust a back end's claim without checking it."""
-    sol = Solution(status=raw.status, bound=raw.bound, solver=cls.name,
-                   solver_version=cls.version(), relaxation=relax,
+    ran = get_backend(raw.solver) if raw.solver and raw.solver != cls.name else cls
+    sol = Solution(status=raw.status, bound=raw.bound, solver=ran.name,
+                   solver_version=ran.version(), relaxation=relax,
                    message=raw.message, info=dict(raw.info),
                    times={"build": raw.build_time, "solve": raw.solve_time})
     if relax == "lp":
@@ -167,7 +147,7 @@ def _finalise(problem: AssignmentProblem, cls: type[Backend], raw: RawResult,
         sol.objective = problem.objective_of(sel)
     if sol.objective is not None and sol.bound is not None and sol.bound > sol.objective:
         sol.bound = sol.objective   # tolerance noise: a lower bound never exceeds the optimum
-    if sol.status is Status.OPTIMAL and sol.bound is None and cls.exact:
+    if sol.status is Status.OPTIMAL and sol.bound is None and ran.exact:
         sol.bound = sol.objective
     if sol.selected is not None:
         sol.tuples = problem.tuples[sol.selected[~problem.slack[sol.selected]]].copy()

@@ -261,11 +261,9 @@ def feasibility(problem: AssignmentProblem, *, time_limit: float | None = 60.0
         a, i = missing[0]
         more = f" (and {len(missing) - 1} more)" if len(missing) > 1 else ""
         return False, f"{index_label(a, i)} is covered by no candidate{more}"
-    T = problem.tuples
-    real = T > 0
-    single = real.sum(axis=1) == 1
+    R = problem.entry_rows[(problem.tuples > 0).sum(axis=1) == 1]
     hit = np.zeros(problem.n_rows, dtype=bool)
-    hit[(T[single] - 1 + problem.row_offsets[None, :])[real[single]]] = True
+    hit[R[R >= 0]] = True
     if hit.all():
         return True, "every real index has a single-index (dummy) candidate"
     if problem.kind == "dense" and int((~problem.slack).sum()) == math.prod(problem.sizes):

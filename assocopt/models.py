@@ -35,7 +35,6 @@ back end rejects raise :class:`ModelError` naming the key and the file.
 
 from __future__ import annotations
 
-import math
 import os
 import tomllib
 from dataclasses import dataclass, field
@@ -209,9 +208,10 @@ def find_model(name_or_path: str | os.PathLike[str]) -> Path:
 def load_model(name_or_path: str | os.PathLike[str], *, check_options: bool = True) -> Model:
     """Read and validate a model by file stem or path.
 
-    ``check_options``: let the back end judge its own options on a tiny problem, so
-    that an unknown or bad back-end option fails here, naming the file (skipped when
-    the back end's package is not installed).
+    ``check_options``: check the back end's own options against its declaration
+    (:mod:`assocopt.solvers.options`, no trial solve), so that an unknown or bad
+    back-end option fails here, naming the file (names a back end passes through to
+    its solver are judged only when that solver is installed).
     """
     return _parse_file(find_model(name_or_path), check_options=check_options)
 
@@ -276,8 +276,8 @@ def _from_dict(doc: dict[str, Any], path: Path, *, check_options: bool) -> Model
                   options=MappingProxyType(options), cost=cost, description=description,
                   path=path)
     extras = {k: v for k, v in options.items() if k not in COMMON_OPTIONS}
-    if check_options and extras and cls.is_available():
-        _probe(model, extras, path)
+    if check_options and extras:
+        _check_backend_options(cls, extras, path)
     return model
 
 
@@ -301,26 +301,21 @@ def _incompatible(formulation: str, solver: str, cls: Any) -> str | None:
 
 
 def _options(raw: Any, path: Path) -> dict[str, Any]:
+    """The ``[options]`` table: the common options checked by the one checker of
+    :mod:`assocopt.solvers.options`; back-end options must be plain values."""
+    from .solvers.options import COMMON_OPTIONS as DECLARED
+
     if not isinstance(raw, dict):
         raise _fail(path, "options", f"must be a table ([options]), found {_type_name(raw)}")
+    common = {o.name: o for o in DECLARED}
     out: dict[str, Any] = {}
     for key, v in raw.items():
         where = f"options.{key}"
-        if key == "time_limit":
-            if isinstance(v, bool) or not isinstance(v, (int, float)) or not v > 0 \
-                    or math.isinf(v):
-                raise _fail(path, where, f"must be a positive number of seconds, found {v!r}")
-            v = float(v)
-        elif key == "mip_gap":
-            if isinstance(v, bool) or not isinstance(v, (int, float)) or not 0 <= v < math.inf:
-                raise _fail(path, where, f"must be a number >= 0, found {v!r}")
-            v = float(v)
-        elif key == "threads":
-            if isinstance(v, bool) or not isinstance(v, int) or v < 1:
-                raise _fail(path, where, f"must be a positive integer, found {v!r}")
-        elif key == "verbose":
-            if not isinstance(v, bool):
-                raise _fail(path, where, f"must be true or false, found {v!r}")
+        if key in common:
+            try:
+                v = common[key].check(v)
+            except ValueError as exc:
+                raise _fail(path, where, str(exc)) from None
         elif isinstance(v, (list,)) or hasattr(v, "isoformat"):
             raise _fail(path, where, f"back-end options must be numbers, strings, booleans "
                                      f"or tables, found {_type_name(v)}")
@@ -361,32 +356,15 @@ def _cost(raw: Any, path: Path) -> Mapping[str, Any]:
     return MappingProxyType({"builder": builder, "params": MappingProxyType(dict(params))})
 
 
-def _probe(model: Model, extras: dict[str, Any], path: Path) -> None:
-    """Let the back end judge its own options on a tiny problem (2 x 2, or 2 x 2 x 2)."""
-    from .api import solve
-    from .problem import AssignmentProblem
+def _check_backend_options(cls: Any, extras: dict[str, Any], path: Path) -> None:
+    """The back end's own options checked against its declaration (no trial solve)."""
+    from .solvers.options import OptionError
 
-    from .solvers import get_backend
-
-    two_d = get_backend(model.solver).max_ndim == 2
-    tiny = AssignmentProblem.dense([[0.0, 1.0], [1.0, 0.0]] if two_d else
-                                   [[[0.0, 1.0], [1.0, 1.0]], [[1.0, 1.0], [1.0, 0.0]]])
-
-    def why(opts: dict[str, Any]) -> str | None:
-        try:
-            solve(tiny, model.solver, relax=model.relax, **opts)
-        except AssocoptError as exc:
-            return str(exc)
-        except (TypeError, ValueError) as exc:
-            return f"{type(exc).__name__}: {exc}"
-        return None
-
-    together = why(extras)      # options may depend on each other (cvxpy_solver + ...)
-    if together is None:
-        return
-    for key, value in extras.items():
-        alone = why({key: value})
-        if alone is not None:
-            raise _fail(path, f"options.{key}",
-                        f"rejected by back end {model.solver!r}: {alone}")
-    raise _fail(path, "options", f"rejected by back end {model.solver!r}: {together}")
+    if not cls.is_available() and cls.native_options:
+        declared = {o.name for o in cls.options}
+        extras = {k: v for k, v in extras.items() if k in declared}
+    try:
+        cls.parse_options(extras)
+    except OptionError as exc:
+        raise _fail(path, f"options.{exc.option}",
+                    f"rejected by back end {cls.name!r}: {exc}") from None

@@ -7,9 +7,10 @@ that back end is asked for, and then fails with a message naming the package.
 
 from .base import (Backend, RawResult, SolveOptions, available, get_backend,
                    register, registered)
+from .options import Option, OptionError
 from . import highs, scipy_milp, scipy_lsa, bruteforce, greedy  # noqa: F401  (register)
 from . import lap, lagrangian, bnb  # noqa: F401  (register)
 from . import ortools_cpsat, ortools_mip, cvxpy_backend  # noqa: F401  (register)
 
-__all__ = ["Backend", "RawResult", "SolveOptions", "available", "get_backend",
-           "register", "registered"]
+__all__ = ["Backend", "RawResult", "SolveOptions", "Option", "OptionError", "available",
+           "get_backend", "register", "registered"]

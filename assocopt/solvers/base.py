@@ -17,12 +17,14 @@ from typing import Any, ClassVar
 
 import numpy as np
 
-from ..errors import SolverNotInstalledError, UnknownSolverError
+from ..errors import (InvalidProblemError, SolverCapabilityError, SolverNotInstalledError,
+                      UnknownSolverError)
 from ..problem import AssignmentProblem
 from ..solution import Status
+from .options import Option, check_common, parse_options
 
 __all__ = ["SolveOptions", "RawResult", "Backend", "register", "get_backend",
-           "registered", "available"]
+           "registered", "available", "check_capabilities", "Option"]
 
 
 @dataclass(frozen=True)
@@ -41,6 +43,14 @@ class SolveOptions:
         Worker threads for back ends that use them (None: the back end's default).
     verbose : bool
         Let the back end print its log.
+    extra : dict
+        The back end's own options; ``parsed`` says they were already checked
+        against its declaration (:meth:`Backend.parse_options`, done by
+        :func:`assocopt.solve`), so the back end need not check them again.
+
+    The common options are checked here (:func:`~assocopt.solvers.options.check_common`),
+    so a back end called directly gets the same checks as one called through
+    :func:`assocopt.solve`.
     """
 
     relax: str | None = None
@@ -49,6 +59,14 @@ class SolveOptions:
     threads: int | None = None
     verbose: bool = False
     extra: dict[str, Any] = field(default_factory=dict)
+    parsed: bool = False
+
+    def __post_init__(self) -> None:
+        if self.relax not in (None, "lp"):
+            raise InvalidProblemError(f"relax must be None or 'lp', got {self.relax!r}")
+        values = check_common(self.time_limit, self.mip_gap, self.threads, self.verbose)
+        for name, value in zip(("time_limit", "mip_gap", "threads", "verbose"), values):
+            object.__setattr__(self, name, value)
 
 
 @dataclass
@@ -61,7 +79,9 @@ class RawResult:
     ``objective``: the back end's own objective (used for LPs; for integral
     solutions the objective is recomputed from the costs);
     ``build_time`` / ``solve_time``: seconds spent building the back end's model
-    and inside the back end's solve call.
+    and inside the back end's solve call; ``solver``: the method that produced the
+    answer when it is not the back end that was called (a fallback; its name is then
+    reported as ``Solution.solver``).
     """
 
     status: Status
@@ -73,6 +93,7 @@ class RawResult:
     info: dict[str, Any] = field(default_factory=dict)
     build_time: float = 0.0
     solve_time: float = 0.0
+    solver: str = ""
 
 
 @functools.lru_cache(maxsize=None)
@@ -105,6 +126,11 @@ class Backend:
     largest N it accepts (None: any); ``supports_time_limit``;
     ``exact_float_costs``: proves optimality for arbitrary float costs, not only for
     integer ones (False for CP-SAT, which scales costs to integers).
+
+    ``options``: the back end's own options, declared once (see
+    :mod:`assocopt.solvers.options`); ``native_options``: when not empty, the back
+    end also passes other names through to its solver (say which, e.g. "any HiGHS
+    option by name"), and :meth:`is_native_option` tells which names exist.
     """
 
     name: ClassVar[str] = ""
@@ -118,6 +144,24 @@ class Backend:
     max_ndim: ClassVar[int | None] = None
     supports_time_limit: ClassVar[bool] = False
     exact_float_costs: ClassVar[bool] = True
+    options: ClassVar[tuple[Option, ...]] = ()
+    native_options: ClassVar[str] = ""
+
+    @classmethod
+    def is_native_option(cls, name: str) -> bool:
+        """Whether ``name`` is an option of the underlying solver (passed through)."""
+        return False
+
+    @classmethod
+    def parse_options(cls, given: dict[str, Any]) -> dict[str, Any]:
+        """``given`` checked against :attr:`options`, defaults filled in."""
+        return parse_options(cls, given)
+
+    def settings(self, problem: AssignmentProblem, options: SolveOptions) -> dict[str, Any]:
+        """What every ``solve`` starts with: refuse what the capability flags rule
+        out, and the parsed options (taken as they are when already parsed)."""
+        check_capabilities(type(self), problem, options.relax)
+        return dict(options.extra) if options.parsed else self.parse_options(options.extra)
 
     @classmethod
     def is_available(cls) -> bool:
@@ -144,6 +188,20 @@ class Backend:
 
     def solve(self, problem: AssignmentProblem, options: SolveOptions) -> RawResult:
         raise NotImplementedError
+
+
+def check_capabilities(cls: type[Backend], problem: AssignmentProblem,
+                       relax: str | None) -> None:
+    """Raise :class:`SolverCapabilityError` when ``cls``'s flags rule the request out."""
+    if relax == "lp" and not cls.lp:
+        raise SolverCapabilityError(f"solver {cls.name!r} cannot solve LP relaxations")
+    if relax is None and not cls.integer:
+        raise SolverCapabilityError(f"solver {cls.name!r} solves LP relaxations only; "
+                                    "pass relax='lp'")
+    if cls.max_ndim is not None and problem.ndim > cls.max_ndim:
+        raise SolverCapabilityError(
+            f"solver {cls.name!r} handles problems of at most {cls.max_ndim} axes, "
+            f"this one has {problem.ndim}")
 
 
 _REGISTRY: dict[str, type[Backend]] = {}

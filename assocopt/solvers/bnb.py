@@ -66,17 +66,19 @@ from typing import Any
 
 import numpy as np
 
-from ..errors import InvalidProblemError, ProblemTooLargeError
+from ..errors import ProblemTooLargeError
 from ..problem import AssignmentProblem
 from ..solution import Status
-from .base import Backend, RawResult, SolveOptions, register, get_backend
+from ..problem import OPT_TOL, kept_axes
+from .base import (Backend, Option, RawResult, SolveOptions, _distribution_version,
+                   get_backend, register)
 
 __all__ = ["BranchBoundBackend", "DEFAULTS", "BnbInput", "MAX_DENSE", "MAX_KEPT",
            "kept_sizes", "too_large"]
 
 #: Relative tolerance of "bound meets objective" for non-integer costs (round-off),
 #: the same as the Lagrangian back ends' ``OPT_TOL``.
-TOL = 1e-9
+TOL = OPT_TOL
 
 #: Largest dense matrix (entries) the kernels allocate: ``(n_a+1)(n_b+1)`` for the
 #: 2-D subproblem, ``(n_a+1)(n_b+1)(n_c+1)`` for the N = 3 recovery lookup.
@@ -85,14 +87,6 @@ MAX_DENSE = 4_000_000
 #: iteration costs O((n_a + n_b)^3), so beyond this ``lagrangian-exact`` (sparse LAP)
 #: is the better engine.
 MAX_KEPT = 400
-
-DEFAULTS: dict[str, Any] = {
-    "max_iter": 100, "probe_every": 15, "probe_nodes": 200, "max_nodes": 200_000,
-    "step0": 2.0, "patience": 10, "step_min": 1e-3, "keep_axes": None, "fallback": True,
-    "deflect": 0.5, "recover_every": 1, "warm_start": True,
-    "stall_tol": 0.0,
-}
-
 
 def kept_sizes(problem: AssignmentProblem, keep_axes: Any = None) -> tuple[int, int]:
     """``(n_a, n_b)``: the sizes of the two kept axes."""
@@ -144,47 +138,35 @@ class BnbInput:
 
 
 def _keep(sizes: tuple[int, ...], keep_axes: Any) -> tuple[int, int]:
-    """The two kept axes: given, or the two largest (first on ties)."""
-    N = len(sizes)
-    if keep_axes is None:
-        order = sorted(range(N), key=lambda s: -sizes[s])
-        return min(order[:2]), max(order[:2])
-    try:
-        a, b = (int(s) for s in keep_axes)
-    except (TypeError, ValueError):
-        raise InvalidProblemError(f"keep_axes must be two axis numbers, got {keep_axes!r}")
-    if a == b or not (0 <= a < N and 0 <= b < N):
-        raise InvalidProblemError(f"keep_axes must be two different axes in 0..{N - 1}, "
-                                  f"got {keep_axes!r}")
-    return min(a, b), max(a, b)
+    """The two kept axes: given, or the two largest (see :func:`assocopt.problem.kept_axes`)."""
+    return kept_axes(sizes, keep_axes)
 
 
-def _parse(extra: dict[str, Any]) -> dict[str, Any]:
-    unknown = set(extra) - set(DEFAULTS)
-    if unknown:
-        raise InvalidProblemError(f"unknown option(s) for solver 'bnb': {sorted(unknown)}; "
-                                  f"valid: {sorted(DEFAULTS)}")
-    p = dict(DEFAULTS, **extra)
-    for key in ("max_iter", "probe_every", "probe_nodes", "max_nodes", "patience",
-                "recover_every"):
-        if int(p[key]) < 0 or (key in ("max_nodes", "patience") and int(p[key]) < 1):
-            raise InvalidProblemError(f"option {key} must be a positive integer, "
-                                      f"got {p[key]!r}")
-        p[key] = int(p[key])
-    for key in ("step0", "step_min"):
-        p[key] = float(p[key])
-        if not p[key] > 0:
-            raise InvalidProblemError(f"option {key} must be positive, got {p[key]!r}")
-    p["deflect"] = float(p["deflect"])
-    if not 0.0 <= p["deflect"] < 1.0:
-        raise InvalidProblemError(f"option deflect must be in [0, 1), got {p['deflect']!r}")
-    p["fallback"] = bool(p["fallback"])
-    p["warm_start"] = bool(p["warm_start"])
-    p["stall_tol"] = float(p["stall_tol"])
-    if not 0.0 <= p["stall_tol"] < 1.0:
-        raise InvalidProblemError(f"option stall_tol must be in [0, 1), got "
-                                  f"{p['stall_tol']!r}")
-    return p
+OPTIONS: tuple[Option, ...] = (
+    Option("max_iter", "int", 100, "subgradient iterations", low=0),
+    Option("probe_every", "int", 15, "iterations between short searches (0: none)", low=0),
+    Option("probe_nodes", "int", 200, "nodes per short search", low=0),
+    Option("max_nodes", "int", 200_000, "nodes of the final search", low=1),
+    Option("step0", "float", 2.0, "Polyak step scale", low=0.0, low_open=True),
+    Option("patience", "int", 10, "iterations without a better bound before the step "
+           "scale halves", low=1),
+    Option("step_min", "float", 1e-3, "step scale at which the ascent ends", low=0.0,
+           low_open=True),
+    Option("keep_axes", "axes", None, "the two kept axes (None: the two largest)",
+           nullable=True),
+    Option("fallback", "bool", True, "hand the problem to lagrangian-exact when the node "
+           "budget is spent or it is too large for the kernels"),
+    Option("deflect", "float", 0.5, "share of the previous direction kept", low=0.0,
+           high=1.0, high_open=True),
+    Option("recover_every", "int", 1, "N = 3 primal recovery every k iterations "
+           "(0: never)", low=0),
+    Option("warm_start", "bool", True, "each Hungarian solve starts from the previous "
+           "potentials"),
+    Option("stall_tol", "float", 0.0, "leave the ascent when the bound gained less than "
+           "this share of the gap since the last short search (0: off)", low=0.0,
+           high=1.0, high_open=True),
+)
+DEFAULTS: dict[str, Any] = {o.name: o.default for o in OPTIONS}
 
 
 @register
@@ -197,11 +179,16 @@ class BranchBoundBackend(Backend):
     description = ("compiled Lagrangian-bounded exact-cover branch and bound "
                    "(numba; small S-D problems)")
     supports_time_limit = True
+    options = OPTIONS
+
+    @classmethod
+    def version(cls) -> str:
+        """assocopt's version: the method is assocopt's (numba only compiles it)."""
+        from .. import __version__
+        return __version__
 
     def solve(self, problem: AssignmentProblem, options: SolveOptions) -> RawResult:
-        if options.relax is not None:
-            raise InvalidProblemError("solver 'bnb' solves the ILP only; use relax=None")
-        p = _parse(options.extra)
+        p = self.settings(problem, options)
         t0 = time.perf_counter()
         from . import bnb_kernels as kern      # imports numba: only when asked for
 
@@ -234,7 +221,8 @@ class BranchBoundBackend(Backend):
         params.update(keep_axes=[inp.a, inp.b], tol=TOL)
         info: dict[str, Any] = {"iterations": int(iters), "nodes": int(nodes),
                                 "lagrangian_bound": float(bound), "parameters": params,
-                                "integer_costs": inp.int_costs}
+                                "integer_costs": inp.int_costs,
+                                "numba_version": _distribution_version("numba")}
         selected = np.sort(sel[:n_sel]) if n_sel > 0 else None
         if out == kern.INFEASIBLE or (out == kern.PROVEN and selected is None):
             why = ("the kept axes admit no assignment" if out == kern.INFEASIBLE
@@ -263,8 +251,9 @@ class BranchBoundBackend(Backend):
         sub = SolveOptions(time_limit=left, mip_gap=options.mip_gap,
                            threads=options.threads, verbose=options.verbose)
         raw = get_backend("lagrangian-exact")().solve(problem, sub)
-        raw.info = dict(raw.info, bnb=info)
         why = info.get("reason", "node budget spent")
+        raw.info = dict(raw.info, bnb=info, requested="bnb", fallback=why)
+        raw.solver = "lagrangian-exact"      # the method that produced the answer
         raw.message = f"bnb: {why}, then {raw.message}"
         raw.solve_time = time.perf_counter() - t0 - raw.build_time
         return raw

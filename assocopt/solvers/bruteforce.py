@@ -18,10 +18,9 @@ from typing import Iterator
 
 import numpy as np
 
-from ..errors import InvalidProblemError
 from ..problem import AssignmentProblem
 from ..solution import Status
-from .base import Backend, RawResult, SolveOptions, register
+from .base import Backend, Option, RawResult, SolveOptions, register
 
 __all__ = ["BruteForceBackend", "enumerate_solutions", "count_solutions"]
 
@@ -108,6 +107,8 @@ class BruteForceBackend(Backend):
 
     name = "bruteforce"
     description = "exhaustive enumeration of exact covers (tiny instances, test oracle)"
+    options = (Option("max_nodes", "int", DEFAULT_MAX_NODES,
+                      "search nodes; past them the search stops with time_limit", low=1),)
 
     @classmethod
     def version(cls) -> str:
@@ -117,11 +118,7 @@ class BruteForceBackend(Backend):
     def solve(self, problem: AssignmentProblem, options: SolveOptions) -> RawResult:
         from ..errors import ProblemTooLargeError
 
-        unknown = set(options.extra) - {"max_nodes"}
-        if unknown:
-            raise InvalidProblemError(f"unknown option(s) for solver 'bruteforce': "
-                                      f"{sorted(unknown)}; valid: ['max_nodes']")
-        max_nodes = int(options.extra.get("max_nodes", DEFAULT_MAX_NODES))
+        max_nodes = self.settings(problem, options)["max_nodes"]
         t0 = time.perf_counter()
         best, best_cost, count = None, math.inf, 0
         costs = problem.costs

@@ -37,7 +37,8 @@ from ..errors import InvalidProblemError, SolverCapabilityError, SolverNotInstal
 from ..formulation import build_model
 from ..problem import AssignmentProblem
 from ..solution import Status, relative_gap
-from .base import Backend, RawResult, SolveOptions, register
+from .base import Backend, Option, RawResult, SolveOptions, register
+from .status import from_table, settle_optimal
 
 __all__ = ["CvxpyBackend"]
 
@@ -65,8 +66,6 @@ _INACCURATE_IS_LIMIT = ("SCIPY",)
 #: CVXPY 1.9 interfaces that fail on any variable bounds (even ``nonneg``): the LP
 #: uses ``0 <= x <= 1`` constraint rows instead.
 _NO_VARIABLE_BOUNDS = ("PDLP",)
-#: Reached relative gaps up to this count as zero, as in the HiGHS back end.
-_GAP_ZERO = 1e-9
 
 
 def _limit_options(solver: str, options: SolveOptions,
@@ -143,8 +142,6 @@ def _choose_solver(requested: Any, is_mip: bool, installed: list[str]) -> str:
         raise SolverNotInstalledError(
             f"cvxpy has no {'MIP' if is_mip else 'LP'} solver installed; install one of "
             f"{', '.join(order)} (e.g. pip install highspy)")
-    if not isinstance(requested, str):
-        raise InvalidProblemError(f"cvxpy_solver must be a string, got {requested!r}")
     name = requested.upper()
     if name not in installed:
         raise SolverNotInstalledError(
@@ -166,20 +163,21 @@ class CvxpyBackend(Backend):
     description = "CVXPY model (boolean x, A @ x == 1) on HiGHS or another installed solver"
     lp = True
     supports_time_limit = True
+    options = (
+        Option("cvxpy_solver", "str", None, "CVXPY solver name (None: the first installed "
+               "of HIGHS, SCIP, ... for the ILP; HIGHS, CLARABEL, ... for the LP)",
+               nullable=True),
+        Option("solver_options", "dict", {}, "solver keyword options passed to CVXPY, "
+               "merged over the limits assocopt sets"),
+    )
 
     def solve(self, problem: AssignmentProblem, options: SolveOptions) -> RawResult:
         import cvxpy as cp
 
         is_mip = options.relax is None
-        extra = dict(options.extra)
-        requested = extra.pop("cvxpy_solver", None)
-        user_opts = extra.pop("solver_options", {})
-        if extra:
-            raise InvalidProblemError(
-                f"unknown cvxpy option {sorted(extra)[0]!r}; valid: 'cvxpy_solver', "
-                "'solver_options'")
-        if not isinstance(user_opts, dict):
-            raise InvalidProblemError("cvxpy option solver_options must be a dict")
+        extra = self.settings(problem, options)
+        requested = extra["cvxpy_solver"]
+        user_opts = dict(extra["solver_options"])
         solver = _choose_solver(requested, is_mip, cp.installed_solvers())
         limit_opts, passed = _limit_options(solver, options, is_mip)
         solver_opts = _merge(limit_opts, user_opts)
@@ -270,18 +268,13 @@ class CvxpyBackend(Backend):
     def _status(native: str, solver: str, objective: float | None, bound: float | None,
                 options: SolveOptions, is_mip: bool, elapsed: float) -> tuple[Status, str]:
         """Map ``native`` through ``_STATUS_TABLE`` and refine it."""
-        status = _STATUS_TABLE.get(native, Status.ERROR)
+        status = from_table(_STATUS_TABLE, native)
         limit_elapsed = options.time_limit is not None and elapsed >= options.time_limit
         if native == "optimal_inaccurate" and (solver in _INACCURATE_IS_LIMIT or limit_elapsed):
             return Status.TIME_LIMIT, "stopped by a limit"
         if native == "infeasible_inaccurate":
             return status, "infeasibility reported with reduced accuracy"
-        if status is Status.OPTIMAL and is_mip and options.mip_gap > 0:
-            gap = relative_gap(objective, bound)
-            if gap is None:
-                return Status.FEASIBLE, "mip_gap > 0 and the solver reports no bound"
-            if gap > _GAP_ZERO:
-                return Status.FEASIBLE, f"stopped at relative gap {gap:.3g}"
         if native not in _STATUS_TABLE:
             return Status.ERROR, f"unexpected CVXPY status {native!r}"
-        return status, ""
+        return settle_optimal(status, relative_gap(objective, bound),
+                              options.mip_gap if is_mip else 0.0)

@@ -35,8 +35,7 @@ def take_in_order(problem: AssignmentProblem, order: np.ndarray
     The sequential scan is inherent to the rule; its per-candidate work is a few
     array lookups on the precomputed row indices (no model is built).
     """
-    T = problem.tuples
-    rows = np.where(T > 0, T - 1 + problem.row_offsets[None, :], -1)
+    rows = problem.entry_rows
     covered = np.zeros(problem.n_rows + 1, dtype=bool)   # last slot absorbs the -1 rows
     chosen = []
     remaining = problem.n_rows
@@ -68,6 +67,7 @@ class GreedyBackend(Backend):
         return __version__
 
     def solve(self, problem: AssignmentProblem, options: SolveOptions) -> RawResult:
+        self.settings(problem, options)          # no options of its own: rejects any
         t0 = time.perf_counter()
         selected, covered = greedy_select(problem)
         dt = time.perf_counter() - t0

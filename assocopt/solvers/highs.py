@@ -7,6 +7,7 @@ Extra keyword options are passed to HiGHS by name (``presolve="off"``,
 
 from __future__ import annotations
 
+import functools
 import time
 from typing import Any
 
@@ -17,11 +18,30 @@ from ..formulation import LinearModel, build_model
 from ..problem import AssignmentProblem
 from ..solution import Status
 from .base import Backend, RawResult, SolveOptions, register
+from .status import from_table, settle_optimal
 
 __all__ = ["HighsBackend", "highs_from_model"]
 
-_LIMIT_STATUSES = ("kTimeLimit", "kIterationLimit", "kSolutionLimit", "kInterrupt",
-                   "kHighsInterrupt", "kObjectiveBound", "kObjectiveTarget")
+#: HiGHS model status name -> assocopt status.  Variables are bounded, so
+#: "unbounded or infeasible" means infeasible; every limit is a time limit.
+_STATUS_TABLE: dict[str, Status] = {
+    "kOptimal": Status.OPTIMAL,
+    "kInfeasible": Status.INFEASIBLE,
+    "kUnboundedOrInfeasible": Status.INFEASIBLE,
+    "kTimeLimit": Status.TIME_LIMIT,
+    "kIterationLimit": Status.TIME_LIMIT,
+    "kSolutionLimit": Status.TIME_LIMIT,
+    "kInterrupt": Status.TIME_LIMIT,
+    "kHighsInterrupt": Status.TIME_LIMIT,
+    "kObjectiveBound": Status.TIME_LIMIT,
+    "kObjectiveTarget": Status.TIME_LIMIT,
+}
+
+
+@functools.lru_cache(maxsize=None)
+def _highs_option_names() -> frozenset[str]:
+    import highspy
+    return frozenset(n for n in dir(highspy.HighsOptions()) if not n.startswith("_"))
 
 
 def highs_from_model(model: LinearModel, options: SolveOptions | None = None) -> Any:
@@ -68,13 +88,21 @@ class HighsBackend(Backend):
     description = "HiGHS MIP/LP solver through highspy, model passed as one CSR matrix"
     lp = True
     supports_time_limit = True
+    native_options = "any HiGHS option by name (presolve=\"off\", mip_heuristic_effort=0.1, ...)"
+
+    @classmethod
+    def is_native_option(cls, name: str) -> bool:
+        return cls.is_available() and name in _highs_option_names()
 
     def solve(self, problem: AssignmentProblem, options: SolveOptions) -> RawResult:
         import highspy
 
+        extra = self.settings(problem, options)
         t0 = time.perf_counter()
         model = build_model(problem, options.relax)
-        h = highs_from_model(model, options)
+        h = highs_from_model(model, SolveOptions(
+            relax=options.relax, time_limit=options.time_limit, mip_gap=options.mip_gap,
+            threads=options.threads, verbose=options.verbose, extra=extra, parsed=True))
         t1 = time.perf_counter()
         h.run()
         t2 = time.perf_counter()
@@ -101,12 +129,6 @@ class HighsBackend(Backend):
 
     @staticmethod
     def _status(name: str, model: LinearModel, info: Any, options: SolveOptions) -> Status:
-        if name == "kOptimal":
-            if model.is_mip and options.mip_gap > 0 and info.mip_gap > 1e-9:
-                return Status.FEASIBLE   # stopped at the requested gap, not proven
-            return Status.OPTIMAL
-        if name in ("kInfeasible", "kUnboundedOrInfeasible"):
-            return Status.INFEASIBLE     # variables are bounded: never unbounded
-        if name in _LIMIT_STATUSES:
-            return Status.TIME_LIMIT
-        return Status.ERROR
+        status = from_table(_STATUS_TABLE, name)
+        gap = float(info.mip_gap) if model.is_mip else 0.0
+        return settle_optimal(status, gap, options.mip_gap if model.is_mip else 0.0)[0]

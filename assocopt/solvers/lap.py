@@ -30,7 +30,7 @@ import scipy.sparse as sp
 
 from ..problem import AssignmentProblem
 from ..solution import Status
-from .base import Backend, RawResult, SolveOptions, register
+from .base import Backend, Option, RawResult, SolveOptions, register
 
 __all__ = ["LapInfeasibleError", "lapx_available", "linear_assignment",
            "assign_with_misses", "Assignment2D", "assignment_duals", "LapjvBackend",
@@ -298,19 +298,14 @@ class LapjvBackend(Backend):
     distribution = "lapx"
     description = "lapx Jonker-Volgenant LAP (dense) / scipy LAPJVsp (sparse), 2-D only"
     max_ndim = 2
+    options = (Option("method", "choice", "auto", "LAP engine: lapx (dense; 'auto' "
+                      "means lapx) or scipy's sparse LAPJVsp",
+                      choices=("auto", "lapx", "sparse")),)
 
     def solve(self, problem: AssignmentProblem, options: SolveOptions) -> RawResult:
-        from ..errors import InvalidProblemError
         from .scipy_lsa import ScipyLsaBackend, _positions
 
-        unknown = set(options.extra) - {"method"}
-        if unknown:
-            raise InvalidProblemError(f"unknown option(s) for solver 'lapjv': "
-                                      f"{sorted(unknown)}; valid: ['method']")
-        method = options.extra.get("method", "auto")
-        if method not in ("auto", "lapx", "sparse"):
-            raise InvalidProblemError(
-                f"option method must be 'auto', 'lapx' or 'sparse', got {method!r}")
+        method = self.settings(problem, options)["method"]
         lap_method = "lapx" if method == "auto" else method
         t0 = time.perf_counter()
         n1, n2 = problem.sizes

@@ -35,7 +35,8 @@ from ..errors import InvalidProblemError
 from ..formulation import build_model
 from ..problem import AssignmentProblem
 from ..solution import Status, relative_gap
-from .base import Backend, RawResult, SolveOptions, register
+from .base import Backend, Option, RawResult, SolveOptions, register
+from .status import from_table, settle_optimal
 
 __all__ = ["CpSatBackend"]
 
@@ -85,14 +86,7 @@ def _scaled_costs(costs: np.ndarray, n_rows: int,
     the original one: a feasible solution picks at most ``rows`` candidates (each
     covers at least one row, and rows are covered once).
     """
-    if isinstance(scale_opt, str) and scale_opt == "auto":
-        scale = _auto_scale(costs, n_rows)
-    elif (isinstance(scale_opt, (int, float, np.integer, np.floating))
-          and not isinstance(scale_opt, bool) and math.isfinite(scale_opt) and scale_opt > 0):
-        scale = float(scale_opt)
-    else:
-        raise InvalidProblemError(
-            f"ortools-cpsat option scale must be 'auto' or a positive number, got {scale_opt!r}")
+    scale = _auto_scale(costs, n_rows) if scale_opt == "auto" else float(scale_opt)
     scaled = costs * scale
     if float(np.abs(scaled).sum()) > _MAX_SCALED_SUM:
         raise InvalidProblemError(
@@ -104,10 +98,9 @@ def _scaled_costs(costs: np.ndarray, n_rows: int,
 
 
 def _apply_parameters(params: Any, options: SolveOptions, extra: dict[str, Any]) -> None:
-    """Common options, then pass-through ``SatParameters`` fields from ``extra``."""
-    seed = extra.pop("seed", 0)
-    if isinstance(seed, bool) or not isinstance(seed, (int, np.integer)):
-        raise InvalidProblemError(f"ortools-cpsat option seed must be an integer, got {seed!r}")
+    """Common options, then pass-through ``SatParameters`` fields from ``extra``
+    (their names were checked by :func:`~assocopt.solvers.options.parse_options`)."""
+    seed = extra.pop("seed")
     params.log_search_progress = bool(options.verbose)
     params.random_seed = int(seed)
     if options.time_limit is not None:
@@ -116,10 +109,6 @@ def _apply_parameters(params: Any, options: SolveOptions, extra: dict[str, Any])
     if options.threads is not None:
         params.num_workers = int(options.threads)
     for key, value in extra.items():
-        if not hasattr(params, key):
-            raise InvalidProblemError(
-                f"unknown ortools-cpsat option {key!r}: not 'scale', 'seed' or a "
-                "CP-SAT SatParameters field")
         try:
             setattr(params, key, value)
         except (TypeError, ValueError) as exc:
@@ -138,12 +127,26 @@ class CpSatBackend(Backend):
     lp = False
     supports_time_limit = True
     exact_float_costs = False   # proves optimality of the integer-scaled costs only
+    options = (
+        Option("scale", "float", "auto", "cost scale before rounding to integers; 'auto': "
+               "1 for integer costs, else the largest safe power of ten",
+               low=0.0, low_open=True, high=math.inf, high_open=True, choices=("auto",)),
+        Option("seed", "int", 0, "CP-SAT random_seed (reproducible with threads=1)"),
+    )
+    native_options = "any CP-SAT SatParameters field by name (max_number_of_conflicts=...)"
+
+    @classmethod
+    def is_native_option(cls, name: str) -> bool:
+        if not cls.is_available():
+            return False
+        from ortools.sat import sat_parameters_pb2
+        return name in sat_parameters_pb2.SatParameters.DESCRIPTOR.fields_by_name
 
     def solve(self, problem: AssignmentProblem, options: SolveOptions) -> RawResult:
         from ortools.sat.python import cp_model
 
-        extra = dict(options.extra)
-        scale_opt = extra.pop("scale", "auto")
+        extra = self.settings(problem, options)
+        scale_opt = extra.pop("scale")
         t0 = time.perf_counter()
         model = build_model(problem, options.relax)
         A, K, n_rows = model.A, model.shape[1], model.shape[0]
@@ -198,7 +201,7 @@ class CpSatBackend(Backend):
     def _status(name: str, response: Any, max_err: float, options: SolveOptions,
                 cp: Any) -> tuple[Status, str]:
         """Map CP-SAT's status through ``_STATUS_TABLE``, then refine OPTIMAL."""
-        status = _STATUS_TABLE.get(name, Status.ERROR)
+        status = from_table(_STATUS_TABLE, name)
         message = f"CP-SAT: {name}"
         if name == "MODEL_INVALID":
             return status, f"CP-SAT: model invalid: {cp.validate()}"
@@ -210,6 +213,5 @@ class CpSatBackend(Backend):
                 f"CP-SAT: optimal for costs rounded to 1/scale (max rounding error "
                 f"{max_err:.3g}); only near-optimal for the original costs, bound "
                 "corrected for the rounding")
-        if options.mip_gap > 0 and gap is not None and gap > 0:
-            return Status.FEASIBLE, f"CP-SAT: stopped at relative gap {gap:.3g}"
-        return Status.OPTIMAL, message
+        status, note = settle_optimal(status, gap, options.mip_gap)
+        return status, f"CP-SAT: {note}" if note else message

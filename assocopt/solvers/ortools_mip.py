@@ -36,7 +36,8 @@ from ..errors import InvalidProblemError, SolverNotInstalledError
 from ..formulation import build_model
 from ..problem import AssignmentProblem
 from ..solution import Status, relative_gap
-from .base import Backend, RawResult, SolveOptions, register
+from .base import Backend, Option, RawResult, SolveOptions, register
+from .status import from_table, settle_optimal
 
 __all__ = ["OrtoolsMipBackend"]
 
@@ -73,8 +74,6 @@ _STATUS_TABLE: dict[str, Status] = {
     "INCOMPATIBLE_OPTIONS": Status.ERROR,
 }
 _NO_RESULT = ("NOT_SOLVED", "UNKNOWN_STATUS", "ABNORMAL")
-#: Reached relative gaps up to this count as zero (float noise), as in the HiGHS back end.
-_GAP_ZERO = 1e-9
 #: A solver claiming OPTIMAL while its own bound is further than this is FEASIBLE
 #: (CP-SAT through model_builder rounds float costs and can do that).
 _CLAIM_TOL = 1e-6
@@ -139,25 +138,26 @@ class OrtoolsMipBackend(Backend):
     description = "OR-Tools model_builder (SCIP MIP / GLOP LP), model passed as one CSR matrix"
     lp = True
     supports_time_limit = True
+    options = (
+        Option("backend", "choice", None, "underlying solver as OR-Tools names it (None: "
+               "scip for the ILP, glop for the LP)",
+               choices=tuple(dict.fromkeys(_MIP_BACKENDS + _LP_BACKENDS)), nullable=True),
+        Option("parameters", "str", "", "solver-specific parameter text appended to "
+               "what assocopt sets"),
+    )
 
     def solve(self, problem: AssignmentProblem, options: SolveOptions) -> RawResult:
         from ortools.linear_solver.python import model_builder_helper as mbh
 
         is_mip = options.relax is None
-        extra = dict(options.extra)
-        backend = extra.pop("backend", "scip" if is_mip else "glop")
-        user_text = extra.pop("parameters", "")
-        if extra:
-            raise InvalidProblemError(
-                f"unknown ortools-mip option {sorted(extra)[0]!r}; valid: 'backend', "
-                "'parameters'")
+        extra = self.settings(problem, options)
+        backend = extra["backend"] or ("scip" if is_mip else "glop")
+        user_text = extra["parameters"]
         allowed = _MIP_BACKENDS if is_mip else _LP_BACKENDS
         if backend not in allowed:
             raise InvalidProblemError(
                 f"ortools-mip backend {backend!r} cannot solve the "
                 f"{'ILP' if is_mip else 'LP relaxation'}; choose one of {list(allowed)}")
-        if not isinstance(user_text, str):
-            raise InvalidProblemError("ortools-mip option parameters must be a string")
 
         with _silenced(not options.verbose):      # Gurobi/Xpress look-ups log to stderr
             solver = mbh.ModelSolverHelper(backend)
@@ -223,7 +223,7 @@ class OrtoolsMipBackend(Backend):
     def _status(native: str, objective: float | None, bound: float | None,
                 options: SolveOptions, elapsed: float) -> tuple[Status, str]:
         """Map ``native`` through ``_STATUS_TABLE`` and refine it (see the table)."""
-        status = _STATUS_TABLE.get(native, Status.ERROR)
+        status = from_table(_STATUS_TABLE, native)
         limit_elapsed = options.time_limit is not None and elapsed >= options.time_limit
         if native in _NO_RESULT and limit_elapsed:
             return Status.TIME_LIMIT, "no solution within the time limit"
@@ -231,7 +231,5 @@ class OrtoolsMipBackend(Backend):
         if native == "FEASIBLE" and options.mip_gap > 0 and gap is not None \
                 and gap <= options.mip_gap and not limit_elapsed:
             return Status.FEASIBLE, f"stopped at relative gap {gap:.3g}"
-        if status is Status.OPTIMAL and gap is not None and \
-                gap > (_GAP_ZERO if options.mip_gap > 0 else _CLAIM_TOL):
-            return Status.FEASIBLE, f"reached relative gap {gap:.3g}, not proven optimal"
-        return status, ""
+        mip_gap = options.mip_gap if options.relax is None else 0.0
+        return settle_optimal(status, gap, mip_gap, claim_tol=_CLAIM_TOL)

@@ -52,6 +52,7 @@ class ScipyLsaBackend(Backend):
     def solve(self, problem: AssignmentProblem, options: SolveOptions) -> RawResult:
         from scipy.optimize import linear_sum_assignment
 
+        self.settings(problem, options)          # no options of its own: rejects any
         t0 = time.perf_counter()
         n1, n2 = problem.sizes
         C = problem.to_cost_matrix()

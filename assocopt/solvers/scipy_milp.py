@@ -11,23 +11,22 @@ import time
 
 import numpy as np
 
-from ..errors import InvalidProblemError
 from ..formulation import build_model
 from ..problem import AssignmentProblem
 from ..solution import Status
-from .base import Backend, RawResult, SolveOptions, register
+from .base import Backend, Option, RawResult, SolveOptions, register
+from .status import from_table, settle_optimal
 
 __all__ = ["ScipyMilpBackend"]
 
 #: scipy.optimize.milp's status codes (see its documentation).
-_STATUS = {
-    0: Status.OPTIMAL,       # optimal solution found
-    1: Status.TIME_LIMIT,    # iteration or time limit reached
-    2: Status.INFEASIBLE,    # problem is infeasible
-    3: Status.ERROR,         # unbounded: impossible with 0 <= x <= 1, so a failure
-    4: Status.ERROR,         # other
+_STATUS_TABLE: dict[str, Status] = {
+    "0": Status.OPTIMAL,       # optimal solution found
+    "1": Status.TIME_LIMIT,    # iteration or time limit reached
+    "2": Status.INFEASIBLE,    # problem is infeasible
+    "3": Status.ERROR,         # unbounded: impossible with 0 <= x <= 1, so a failure
+    "4": Status.ERROR,         # other
 }
-_EXTRA = ("presolve", "node_limit")
 
 
 @register
@@ -40,15 +39,16 @@ class ScipyMilpBackend(Backend):
     description = "scipy.optimize.milp (HiGHS bundled with scipy)"
     lp = True
     supports_time_limit = True
+    options = (
+        Option("presolve", "bool", True, "let HiGHS presolve the model"),
+        Option("node_limit", "int", None, "largest number of branch-and-bound nodes",
+               low=1, nullable=True),
+    )
 
     def solve(self, problem: AssignmentProblem, options: SolveOptions) -> RawResult:
         from scipy.optimize import Bounds, LinearConstraint, milp
 
-        unknown = set(options.extra) - set(_EXTRA)
-        if unknown:
-            raise InvalidProblemError(
-                f"unknown option(s) for solver 'scipy': {sorted(unknown)}; "
-                f"valid: {list(_EXTRA)}")
+        extra = {k: v for k, v in self.settings(problem, options).items() if v is not None}
         t0 = time.perf_counter()
         model = build_model(problem, options.relax)
         constraint = LinearConstraint(model.A, model.row_lower, model.row_upper)
@@ -56,16 +56,15 @@ class ScipyMilpBackend(Backend):
                                    "mip_rel_gap": float(options.mip_gap)}
         if options.time_limit is not None:
             opts["time_limit"] = float(options.time_limit)
-        opts.update(options.extra)
+        opts.update(extra)
         t1 = time.perf_counter()
         res = milp(model.c, integrality=model.integrality, bounds=Bounds(model.lb, model.ub),
                    constraints=constraint, options=opts)
         t2 = time.perf_counter()
-        status = _STATUS.get(int(res.status), Status.ERROR)
         gap = getattr(res, "mip_gap", None)
-        if (status is Status.OPTIMAL and model.is_mip and options.mip_gap > 0
-                and gap is not None and gap > 1e-9):
-            status = Status.FEASIBLE
+        status, _ = settle_optimal(from_table(_STATUS_TABLE, str(int(res.status))),
+                                   None if gap is None else float(gap),
+                                   options.mip_gap if model.is_mip else 0.0)
         bound = getattr(res, "mip_dual_bound", None)
         out = RawResult(status=status, message=f"scipy.milp: {res.message}",
                         build_time=t1 - t0, solve_time=t2 - t1,

@@ -20,12 +20,12 @@ from ..base import Backend, RawResult, SolveOptions, register
 from ..lap import LapInfeasibleError
 from .ascent import _State, _ascent
 from .local_search import _LocalSearch
-from .options import _keep_axes, _parse
+from .options import OPTIONS, OPTIONS_EXACT, check_engines
 from .reduction import dominated
 from .relaxation import _Relaxation
 from .window import (_COMPILED_NODES, _CPSAT_BUDGET, _CPSAT_MAX, _PROBE_SEARCH_MAX,
                      _SEARCH_MAX, _SEARCH_NODES, _compiled_search, _cover_search, _cpsat,
-                     _grow, _has_numba, _has_ortools, _ilp, _uncovered)
+                     Outcome, _grow, _has_numba, _has_ortools, _ilp, _uncovered)
 
 #: The exact mode runs the local search only above this many candidates.
 _LS_MIN_K = 2000
@@ -47,13 +47,14 @@ class _LagrangianBase(Backend):
 
     def solve(self, problem: AssignmentProblem, options: SolveOptions) -> RawResult:
         t_start = time.perf_counter()
-        p = _parse(options.extra, self._exact, self.name)
+        p = self.settings(problem, options)
+        check_engines(p)
         if self._exact and options.mip_gap > 0:
             p["gap_tol"] = max(p["gap_tol"], options.mip_gap)
         deadline = None if options.time_limit is None else t_start + options.time_limit
-        keep = _keep_axes(problem.sizes, p["keep_axes"])
+        keep = problem.kept_axes(p["keep_axes"])
         c = problem.costs
-        integer = bool(np.all(c == np.round(c)) and np.abs(c).max(initial=0) < 2 ** 52)
+        integer = problem.integer_costs
         st = _State(costs=c, integer=integer, theta=p["step0"],
                     history={"bound": [], "best_bound": [], "objective": []}
                     if p["return_history"] else None)
@@ -232,10 +233,10 @@ class _LagrangianBase(Backend):
                 continue
             cap = st.ub if closed else T          # only solutions below cap matter
             status, z, how = self._window(problem, win, red_of, base, lo, cap, closed,
-                                          st, p, options, deadline)
-            rec["result"], rec["solver"] = status, how
-            if status == "kObjectiveTarget" or (status == "kOptimal" and
-                                                 (closed or (z is not None and z < cap))):
+                                          st, p, options, deadline, rec)
+            rec["result"], rec["solver"] = status.value, how
+            if status is Outcome.AT_BOUND or (status is Outcome.OPTIMAL and
+                                              (closed or (z is not None and z < cap))):
                 if st.incumbent is None:
                     st.stop = "infeasible"
                     break
@@ -244,7 +245,8 @@ class _LagrangianBase(Backend):
                 st.bound = max(st.bound, st.ub)
                 st.stop = "proven"
                 break
-            if status == "kInfeasible" or (status == "kOptimal" and z is not None and z >= cap):
+            if status is Outcome.NONE_BELOW or (status is Outcome.OPTIMAL and z is not None
+                                                and z >= cap):
                 if closed:        # nothing below the incumbent (or nothing at all)
                     if st.incumbent is None:
                         st.stop = "infeasible"
@@ -256,21 +258,21 @@ class _LagrangianBase(Backend):
                 lo = T
                 budget = max(budget, _grow(n_in, st.integer))
                 continue
-            st.stop = "time_limit" if status in ("kTimeLimit", "kInterrupt") else "ilp_" + status
+            st.stop = "time_limit" if status is Outcome.LIMIT else \
+                f"window_{status.value}:{rec.get('native', how)}"
             break
         times["windows"] = time.perf_counter() - t0
 
     @staticmethod
     def _window(problem: AssignmentProblem, win: np.ndarray, red_of: np.ndarray, base: float,
                 lo: float, cap: float, closed: bool, st: _State, p: dict[str, Any],
-                options: SolveOptions, deadline: float | None
-                ) -> tuple[str, float | None, str]:
+                options: SolveOptions, deadline: float | None, rec: dict[str, Any]
+                ) -> tuple[Outcome, float | None, str]:
         """Best solution among the candidates ``win`` costing less than ``cap``.
 
-        Returns ``(status, objective, engine)`` in HiGHS's vocabulary: ``kOptimal``
-        (the window's best found, or proven none below ``cap`` when the objective is
-        None or >= cap), ``kInfeasible`` (nothing below ``cap``), ``kObjectiveTarget``
-        (a solution at the proven bound ``lo``: optimal), else a limit.
+        Returns ``(outcome, objective, engine)``, the outcome in the engines' common
+        terms (:class:`~.window.Outcome`); HiGHS's own status, when HiGHS ran, goes
+        into the window record ``rec["native"]``.
         """
         if _has_numba() or len(win) <= _SEARCH_MAX:
             if _has_numba():
@@ -283,9 +285,9 @@ class _LagrangianBase(Backend):
                 how = "search"
             if complete:
                 if sel is None:
-                    return "kInfeasible", None, how
+                    return Outcome.NONE_BELOW, None, how
                 st.offer(sel)
-                return "kOptimal", math.fsum(problem.costs[sel].tolist()), how
+                return Outcome.OPTIMAL, math.fsum(problem.costs[sel].tolist()), how
         start = closed and st.incumbent is not None
         use_cp = st.integer and (p["window_solver"] == "cpsat" or (
             p["window_solver"] == "auto" and len(win) <= _CPSAT_MAX and _has_ortools()))
@@ -297,16 +299,17 @@ class _LagrangianBase(Backend):
             budget = time.perf_counter() + _CPSAT_BUDGET
             cp_deadline = budget if deadline is None else min(budget, deadline)
             status, z = _cpsat(problem, win, st, options, cp_deadline, lo, hi, start=start)
-            if status != "kTimeLimit" or (deadline is not None and
+            if status is not Outcome.LIMIT or (deadline is not None and
                                           time.perf_counter() >= deadline):
                 return status, z, "cpsat"
             how = "cpsat+highs"
         else:
             how = "highs"
         target = lo if st.integer else lo + st.tol()
-        status, z = _ilp(problem, win, st, options, deadline, target, start=start)
-        if status == "kOptimal" and z is not None and z >= cap:
-            return "kInfeasible", z, how
+        status, z, rec["native"] = _ilp(problem, win, st, options, deadline, target,
+                                        start=start)
+        if status is Outcome.OPTIMAL and z is not None and z >= cap:
+            return Outcome.NONE_BELOW, z, how
         return status, z, how
 
     # ------------------------------------------------------------- results
@@ -372,6 +375,7 @@ class LagrangianBackend(_LagrangianBase):
                    "recursive primal recovery, certified gap")
     exact = False
     _exact = False
+    options = OPTIONS
 
 
 @register
@@ -384,3 +388,4 @@ class LagrangianExactBackend(_LagrangianBase):
                    "remaining candidates (proven optimum)")
     exact = True
     _exact = True
+    options = OPTIONS_EXACT

@@ -9,6 +9,7 @@ grows windows is :meth:`~.backend._LagrangianBase._close_gap`.
 
 from __future__ import annotations
 
+import enum
 import math
 import time
 from typing import Any
@@ -42,6 +43,34 @@ _CPSAT_BUDGET = 1.0
 #: feasibility jump off was tried on Grundel n = 50 and did not pay, so HiGHS runs
 #: with its defaults (plus the objective target set below).
 _HIGHS_OPTIONS: dict[str, Any] = {}
+
+
+class Outcome(str, enum.Enum):
+    """What solving one window settled, whichever engine ran (search, CP-SAT, HiGHS).
+
+    ``OPTIMAL``: the window's best solution was found (or, with no objective or one
+    at least the cap, none below the cap exists); ``NONE_BELOW``: proven that nothing
+    in the window costs less than the cap; ``AT_BOUND``: a solution at the proven
+    lower bound was found (so it is optimal); ``LIMIT``: a time limit stopped the
+    engine; ``ERROR``: the engine failed (its own status is in the window record).
+    """
+
+    OPTIMAL = "optimal"
+    NONE_BELOW = "none_below_cap"
+    AT_BOUND = "at_bound"
+    LIMIT = "limit"
+    ERROR = "error"
+
+    def __str__(self) -> str:
+        return self.value
+
+
+#: HiGHS model status -> window outcome (the objective target is the proven bound).
+_HIGHS_OUTCOME: dict[str, Outcome] = {
+    "kOptimal": Outcome.OPTIMAL, "kInfeasible": Outcome.NONE_BELOW,
+    "kObjectiveTarget": Outcome.AT_BOUND, "kTimeLimit": Outcome.LIMIT,
+    "kInterrupt": Outcome.LIMIT,
+}
 
 
 def _grow(n: int, integer: bool) -> int:
@@ -80,19 +109,12 @@ def _has_ortools() -> bool:
 
 def _uncovered(problem: AssignmentProblem, pos: np.ndarray) -> np.ndarray:
     """Constraint rows that none of the candidates ``pos`` covers."""
-    T = problem.tuples[pos]
-    rows = (T - 1 + problem.row_offsets[None, :])[T > 0]
-    return np.flatnonzero(np.bincount(rows, minlength=problem.n_rows) == 0)
+    return problem.uncovered_rows(pos)
 
 
 def _coverage(problem: AssignmentProblem, pos: np.ndarray) -> sp.csr_matrix:
-    T = problem.tuples[pos]
-    real = T > 0
-    rows = (T - 1 + problem.row_offsets[None, :])[real]
-    cols = np.broadcast_to(np.arange(len(T))[:, None], T.shape)[real]
-    A = sp.csr_matrix((np.ones(len(rows)), (rows, cols)), shape=(problem.n_rows, len(T)))
-    A.sort_indices()
-    return A
+    """The coverage matrix of the candidates ``pos`` (one column each)."""
+    return problem.coverage_matrix(pos)
 
 
 def _cover_search(problem: AssignmentProblem, pos: np.ndarray, red: np.ndarray,
@@ -110,8 +132,7 @@ def _cover_search(problem: AssignmentProblem, pos: np.ndarray, red: np.ndarray,
     ``complete`` is False when the node limit stopped the search (nothing proven).
     """
     K = len(pos)
-    T = problem.tuples[pos]
-    rows_of = np.where(T > 0, T - 1 + problem.row_offsets[None, :], -1).tolist()
+    rows_of = problem.entry_rows[pos].tolist()
     cost = problem.costs[pos].tolist()
     rd = np.asarray(red, np.float64).tolist()
     cols = [[r for r in rk if r >= 0] for rk in rows_of]
@@ -173,13 +194,15 @@ def _cover_search(problem: AssignmentProblem, pos: np.ndarray, red: np.ndarray,
 
 
 def _ilp(problem: AssignmentProblem, pos: np.ndarray, st: _State, options: SolveOptions,
-         deadline: float | None, target: float | None, start: bool) -> tuple[str, float | None]:
+         deadline: float | None, target: float | None, start: bool
+         ) -> tuple[Outcome, float | None, str]:
     """HiGHS on the candidates ``pos``; offers any solution found to ``st``.
 
     ``target``: stop as soon as a solution this good is found (it is then optimal:
     ``target`` is a proven lower bound).  ``start``: pass the incumbent (which must be
     among ``pos``) as the starting solution.  Returns HiGHS's model status name and
-    the objective of its solution (None when it has none).
+    the objective of its solution (None when it has none), as
+    ``(outcome, objective, HiGHS's status name)``.
     """
     import highspy
 
@@ -210,16 +233,18 @@ def _ilp(problem: AssignmentProblem, pos: np.ndarray, st: _State, options: Solve
         if problem.violations(sel) is None:
             st.offer(sel)
             z = math.fsum(problem.costs[sel].tolist())
-    return status, z
+    return _HIGHS_OUTCOME.get(status, Outcome.ERROR), z, status
 
 
 def _cpsat(problem: AssignmentProblem, pos: np.ndarray, st: _State, options: SolveOptions,
-           deadline: float | None, lo: float, cap: float, start: bool) -> tuple[str, float | None]:
+           deadline: float | None, lo: float, cap: float, start: bool
+           ) -> tuple[Outcome, float | None]:
     """CP-SAT on the candidates ``pos`` (integer costs), objective at most ``cap``.
 
     ``lo`` (a proven lower bound) is not passed to CP-SAT, see below; ``cap`` is the
-    largest objective of interest.  Returns ``("kOptimal", z)``, ``("kInfeasible",
-    None)`` (nothing in the window costs at most ``cap``) or ``("kTimeLimit", z)``.
+    largest objective of interest.  Returns ``(Outcome.OPTIMAL, z)``,
+    ``(Outcome.NONE_BELOW, None)`` (nothing in the window costs at most ``cap``) or
+    ``(Outcome.LIMIT, z)``.
     """
     from ortools.sat.python import cp_model
 
@@ -252,7 +277,7 @@ def _cpsat(problem: AssignmentProblem, pos: np.ndarray, st: _State, options: Sol
             st.offer(sel)
             z = math.fsum(problem.costs[sel].tolist())
     if code == cp_model.OPTIMAL:
-        return "kOptimal", z
+        return Outcome.OPTIMAL, z
     if code == cp_model.INFEASIBLE:
-        return "kInfeasible", None
-    return "kTimeLimit", z
+        return Outcome.NONE_BELOW, None
+    return Outcome.LIMIT, z
