@@ -12,7 +12,7 @@ from .errors import InvalidProblemError
 from .problem import AssignmentProblem, index_label
 from .solution import Solution, Status
 from .solvers.base import (Backend, RawResult, SolveOptions, check_capabilities,
-                           get_backend, module_installed)
+                           empty_answer, get_backend, module_installed)
 
 __all__ = ["solve", "choose_solver", "BNB_MAX_CANDIDATES"]
 
@@ -112,9 +112,7 @@ def solve(problem: AssignmentProblem, solver: str = "auto", *, relax: str | None
                                 f"candidate{more}",
                         info={"uncovered": missing[:20]})
     elif problem.n_rows == 0:
-        raw = RawResult(Status.OPTIMAL, selected=np.zeros(0, np.int64),
-                        x=np.zeros(problem.n_candidates) if relax else None,
-                        bound=0.0, objective=0.0, message="empty problem")
+        raw = empty_answer(problem, opts)
     else:
         raw = backend_cls().solve(problem, opts)
     sol = _finalise(problem, backend_cls, raw, relax)

@@ -41,8 +41,11 @@ def test_dummies_allowed_only_where_pd_below_one_and_never_all_dummy():
     # singletons only in sensor 1 (the others may miss), and only with dummies elsewhere
     singles = T[n_real == 1]
     assert len(singles) == 2 and (singles[:, 1] > 0).all()
-    assert len(T) == 3 * 2 * 3 - 1 - 4 + 0 or len(T) > 0  # enumerated, none duplicated
-    assert len({tuple(t) for t in T.tolist()}) == len(T)
+    # axes 0 and 2 may miss (index 0..2), axis 1 may not (1..2): every such tuple,
+    # none duplicated (none is all-dummy, since axis 1 is always real)
+    expected = {(a, b, c) for a in range(3) for b in range(1, 3) for c in range(3)}
+    assert len({tuple(t) for t in T.tolist()}) == len(T) == len(expected) == 18
+    assert {tuple(t) for t in T.tolist()} == expected
 
 
 def test_false_alarms_allow_singletons_even_with_pd_one():

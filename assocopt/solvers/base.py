@@ -24,7 +24,7 @@ from ..solution import Status
 from .options import Option, check_common, parse_options
 
 __all__ = ["SolveOptions", "RawResult", "Backend", "register", "get_backend",
-           "registered", "available", "check_capabilities", "Option"]
+           "registered", "available", "check_capabilities", "empty_answer", "Option"]
 
 
 @dataclass(frozen=True)
@@ -202,6 +202,19 @@ def check_capabilities(cls: type[Backend], problem: AssignmentProblem,
         raise SolverCapabilityError(
             f"solver {cls.name!r} handles problems of at most {cls.max_ndim} axes, "
             f"this one has {problem.ndim}")
+
+
+def empty_answer(problem: AssignmentProblem, options: SolveOptions,
+                 name: str = "") -> RawResult | None:
+    """The answer when there is nothing to cover (no real index, so no candidate):
+    the empty selection, optimal.  None for any other problem.  Back ends whose
+    solver refuses an empty model return this first."""
+    if problem.n_rows:
+        return None
+    return RawResult(Status.OPTIMAL, selected=np.zeros(0, np.int64),
+                     x=np.zeros(problem.n_candidates) if options.relax else None,
+                     bound=0.0, objective=0.0,
+                     message=f"{name}: empty problem" if name else "empty problem")
 
 
 _REGISTRY: dict[str, type[Backend]] = {}

@@ -71,7 +71,7 @@ from ..problem import AssignmentProblem
 from ..solution import Status
 from ..problem import OPT_TOL, kept_axes
 from .base import (Backend, Option, RawResult, SolveOptions, _distribution_version,
-                   get_backend, register)
+                   empty_answer, get_backend, register)
 
 __all__ = ["BranchBoundBackend", "DEFAULTS", "BnbInput", "MAX_DENSE", "MAX_KEPT",
            "kept_sizes", "too_large"]
@@ -189,6 +189,8 @@ class BranchBoundBackend(Backend):
 
     def solve(self, problem: AssignmentProblem, options: SolveOptions) -> RawResult:
         p = self.settings(problem, options)
+        if (empty := empty_answer(problem, options, self.name)) is not None:
+            return empty
         t0 = time.perf_counter()
         from . import bnb_kernels as kern      # imports numba: only when asked for
 

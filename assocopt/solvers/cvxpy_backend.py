@@ -37,7 +37,7 @@ from ..errors import InvalidProblemError, SolverCapabilityError, SolverNotInstal
 from ..formulation import build_model
 from ..problem import AssignmentProblem
 from ..solution import Status, relative_gap
-from .base import Backend, Option, RawResult, SolveOptions, register
+from .base import Backend, Option, RawResult, SolveOptions, empty_answer, register
 from .status import from_table, settle_optimal
 
 __all__ = ["CvxpyBackend"]
@@ -176,6 +176,8 @@ class CvxpyBackend(Backend):
 
         is_mip = options.relax is None
         extra = self.settings(problem, options)
+        if (empty := empty_answer(problem, options, self.name)) is not None:
+            return empty
         requested = extra["cvxpy_solver"]
         user_opts = dict(extra["solver_options"])
         solver = _choose_solver(requested, is_mip, cp.installed_solvers())

@@ -17,7 +17,7 @@ from ..errors import InvalidProblemError
 from ..formulation import LinearModel, build_model
 from ..problem import AssignmentProblem
 from ..solution import Status
-from .base import Backend, RawResult, SolveOptions, register
+from .base import Backend, RawResult, SolveOptions, empty_answer, register
 from .status import from_table, settle_optimal
 
 __all__ = ["HighsBackend", "highs_from_model"]
@@ -98,6 +98,8 @@ class HighsBackend(Backend):
         import highspy
 
         extra = self.settings(problem, options)
+        if (empty := empty_answer(problem, options, self.name)) is not None:
+            return empty
         t0 = time.perf_counter()
         model = build_model(problem, options.relax)
         h = highs_from_model(model, SolveOptions(

@@ -14,7 +14,7 @@ import numpy as np
 from ..formulation import build_model
 from ..problem import AssignmentProblem
 from ..solution import Status
-from .base import Backend, Option, RawResult, SolveOptions, register
+from .base import Backend, Option, RawResult, SolveOptions, empty_answer, register
 from .status import from_table, settle_optimal
 
 __all__ = ["ScipyMilpBackend"]
@@ -49,6 +49,8 @@ class ScipyMilpBackend(Backend):
         from scipy.optimize import Bounds, LinearConstraint, milp
 
         extra = {k: v for k, v in self.settings(problem, options).items() if v is not None}
+        if (empty := empty_answer(problem, options, self.name)) is not None:
+            return empty
         t0 = time.perf_counter()
         model = build_model(problem, options.relax)
         constraint = LinearConstraint(model.A, model.row_lower, model.row_upper)
