@@ -3,7 +3,11 @@
 Every exact back end must equal brute force on random small problems of every
 family (2-D square / rectangular / with miss costs, axial 3-D and 4-D, S-D with
 dummies), agree on known cases, detect infeasibility, handle empty problems and
-leave the input untouched.
+leave the input untouched.  Each back end is called directly
+(``Backend().solve(problem, SolveOptions())``) as well as through
+:func:`assocopt.solve`, which answers empty and uncovered problems itself: the
+direct calls make sure the back end's own code is what is checked.  The capability
+flags, the declared options and the registry are checked here too.
 """
 
 from __future__ import annotations
@@ -13,7 +17,7 @@ import pytest
 from hypothesis import given
 
 from assocopt import AssignmentProblem, SolverCapabilityError, Status, solve
-from assocopt.solvers import registered
+from assocopt.solvers import Backend, SolveOptions, registered
 from assocopt.testing import KINDS, assert_feasible, assert_optimal, problems
 
 from conftest import EXACT, LP, installed
@@ -119,18 +123,33 @@ def test_structurally_infeasible(name):
     assert sol.objective is None and sol.tuples is None
 
 
-@pytest.mark.parametrize("name", [installed(n) for n in EXACT])
+@pytest.mark.parametrize("name", [installed(n) for n in EXACT + ["bruteforce"]])
 def test_uncovered_index_is_named(name):
     p = AssignmentProblem.sparse((2, 2), [[1, 1], [2, 1]], [1.0, 2.0])
     sol = solve(p, name)
     assert sol.status is Status.INFEASIBLE
     assert "real index 2 (1-based) of axis 1" in sol.message
+    # solve() names the index before any back end runs: the back end itself must
+    # find the problem infeasible too
+    raw = registered()[name]().solve(p, SolveOptions())
+    assert raw.status is Status.INFEASIBLE, raw.message
+    assert raw.selected is None
+    if p.ndim == 2 and registered()[name].max_ndim is None:
+        p3 = AssignmentProblem.sparse((2, 2, 1), [[1, 1, 1], [2, 1, 0], [0, 0, 1]],
+                                      [1.0, 2.0, 0.0])
+        assert registered()[name]().solve(p3, SolveOptions()).status is Status.INFEASIBLE
 
 
 @pytest.mark.parametrize("name", [installed(n) for n in EXACT + ["bruteforce", "greedy"]])
 def test_empty_problem(name):
-    sol = solve(AssignmentProblem.dense(np.zeros((0, 0))), name)
+    p = AssignmentProblem.dense(np.zeros((0, 0)))
+    sol = solve(p, name)
     assert sol.status is Status.OPTIMAL and sol.objective == 0 and len(sol.tuples) == 0
+    # the same answer from the back end itself (solve() answers it before dispatch)
+    raw = registered()[name]().solve(p, SolveOptions())
+    assert raw.status in ((Status.OPTIMAL,) if registered()[name].exact
+                          else (Status.OPTIMAL, Status.FEASIBLE)), raw.message
+    assert raw.selected is not None and len(raw.selected) == 0
 
 
 @pytest.mark.parametrize("name", [installed(n) for n in EXACT])
@@ -208,3 +227,227 @@ def test_solution_reports_times_and_version():
     assert sol.solver_version
     d = sol.to_dict()
     assert d["status"] == "optimal" and d["time_s"] == sol.times["total"]
+
+
+# ------------------------------------------------------------ direct calls
+ALL = [installed(n) for n in sorted(registered())]
+
+
+def _direct(name: str, p: AssignmentProblem, **kw):
+    return registered()[name]().solve(p, SolveOptions(**kw))
+
+
+def _check_raw(p: AssignmentProblem, raw, ref: float, exact: bool) -> None:
+    """A back end's own answer, before solve()'s checks: feasible, the optimum
+    when exact, never below it, and a bound that is valid."""
+    tol = 1e-9 * max(1.0, abs(ref))
+    if exact:
+        assert raw.status is Status.OPTIMAL, raw.message
+    if raw.selected is not None:
+        sel = np.sort(np.asarray(raw.selected, np.int64))
+        assert p.violations(sel) is None, p.violations(sel)
+        obj = p.objective_of(sel)
+        assert obj >= ref - tol
+        if exact:
+            assert obj == pytest.approx(ref, rel=1e-9, abs=1e-9)
+    else:
+        assert not exact and raw.status is not Status.OPTIMAL, raw.message
+    if raw.bound is not None:
+        assert raw.bound <= ref + tol
+
+
+@pytest.mark.parametrize("name", ALL)
+def test_backend_called_directly_matches_brute_force(name):
+    cls = registered()[name]
+    integer = None if cls.exact_float_costs else True
+
+    @given(problems(_kinds_for(name), integer=integer))
+    def check(p):
+        ref = solve(p, "bruteforce").objective
+        _check_raw(p, _direct(name, p), ref, cls.exact)
+        sol = solve(p, name)                     # and through solve()
+        if cls.exact:
+            assert_optimal(p, sol, reference=ref)
+        elif sol.selected is not None:
+            assert_feasible(p, sol)
+            assert sol.objective >= ref - 1e-9 * max(1.0, abs(ref))
+    check()
+
+
+@pytest.mark.parametrize("name", ALL)
+def test_bound_is_valid_and_gives_bound_tells_the_truth(name):
+    cls = registered()[name]
+
+    @given(problems(_kinds_for(name), integer=True))
+    def check(p):
+        ref = solve(p, "bruteforce").objective
+        sol = solve(p, name)
+        if not cls.gives_bound:
+            assert sol.bound is None, f"{name} claims no bound but reported {sol.bound}"
+            return
+        if sol.status in (Status.OPTIMAL, Status.FEASIBLE):
+            assert sol.bound is not None, f"{name} claims a bound but gave none"
+            assert sol.bound <= ref + 1e-9 * max(1.0, abs(ref))
+    check()
+
+
+# Options that make a back end stop before it has proven anything, where one
+# exists; every other back end with a time limit gets a limit of one nanosecond.
+STOPPERS = {
+    "bruteforce": {"max_nodes": 1},
+    "bnb": {"max_nodes": 1, "probe_every": 0, "max_iter": 1, "recover_every": 0,
+            "fallback": False},
+}
+
+
+@pytest.mark.parametrize("name", [installed(n) for n, cls in sorted(registered().items())
+                                  if n in STOPPERS or cls.supports_time_limit])
+def test_stopped_run_is_never_optimal(name):
+    cls = registered()[name]
+    rng = np.random.default_rng(11)
+    p = (AssignmentProblem.dense(rng.integers(0, 50, (12, 12)).astype(float))
+         if cls.max_ndim == 2 else
+         AssignmentProblem.dense(rng.integers(0, 50, (7, 7, 7)).astype(float)))
+    ref = solve(p, "highs").objective
+    kw = STOPPERS.get(name, {})
+    limit = None if kw else 1e-9
+    for sol in (solve(p, name, time_limit=limit, **kw),
+                _finalised(p, name, _direct(name, p, time_limit=limit, extra=dict(kw)))):
+        if name in STOPPERS:
+            assert sol.status is Status.TIME_LIMIT, sol.message
+        if sol.status is Status.OPTIMAL:    # finished within the limit: then truly
+            assert sol.objective == ref     # optimal (a stopped run never says so)
+        if sol.selected is not None:
+            assert p.violations(sol.selected) is None
+        if sol.bound is not None:
+            assert sol.bound <= ref + 1e-9
+
+
+def _finalised(p, name, raw):
+    from assocopt.api import _finalise
+    return _finalise(p, registered()[name], raw, None)
+
+
+# ------------------------------------------------------------ capability flags
+@pytest.mark.parametrize("name", ALL)
+def test_lp_flag_tells_the_truth(name):
+    cls = registered()[name]
+    p = AssignmentProblem.dense(np.array([[4.0, 1.0], [2.0, 3.0]]))
+    if cls.lp:
+        for sol in (solve(p, name, relax="lp"), _direct(name, p, relax="lp")):
+            assert sol.status is Status.OPTIMAL, sol.message
+            assert sol.x is not None and float(p.costs @ sol.x) == pytest.approx(3.0)
+    else:
+        with pytest.raises(SolverCapabilityError, match="LP"):
+            solve(p, name, relax="lp")
+        with pytest.raises(SolverCapabilityError, match="LP"):
+            _direct(name, p, relax="lp")
+
+
+@pytest.mark.parametrize("name", ALL)
+def test_max_ndim_tells_the_truth(name):
+    cls = registered()[name]
+    p = AssignmentProblem.dense(np.random.default_rng(2).integers(0, 9, (3, 3, 3, 3))
+                                .astype(float))
+    if cls.max_ndim is not None and cls.max_ndim < 4:
+        with pytest.raises(SolverCapabilityError, match="at most"):
+            solve(p, name)
+        with pytest.raises(SolverCapabilityError, match="at most"):
+            _direct(name, p)
+        return
+    ref = solve(p, "highs").objective
+    _check_raw(p, _direct(name, p), ref, cls.exact)
+
+
+# ------------------------------------------------------------ options
+@pytest.mark.parametrize("name", ALL)
+def test_unknown_option_is_rejected_with_one_wording(name):
+    from assocopt.solvers import OptionError
+
+    p = AssignmentProblem.dense(np.ones((2, 2)) if registered()[name].max_ndim == 2
+                                else np.ones((2, 2, 2)))
+    wording = rf"^unknown option 'no_such_option' for solver '{name}'; valid options: "
+    with pytest.raises(OptionError, match=wording):
+        solve(p, name, no_such_option=1)
+    with pytest.raises(OptionError, match=wording):
+        _direct(name, p, extra={"no_such_option": 1})
+    with pytest.raises(OptionError, match=wording):     # even with nothing to solve
+        solve(AssignmentProblem.dense(np.zeros((0, 0))), name, no_such_option=1)
+
+
+@pytest.mark.parametrize("name", ALL)
+def test_declared_options_are_consistent(name):
+    cls = registered()[name]
+    names = [o.name for o in cls.options]
+    assert len(set(names)) == len(names), "an option is declared twice"
+    assert not set(names) & {"time_limit", "mip_gap", "threads", "verbose", "relax"}
+    for o in cls.options:
+        assert o.check(o.default) == o.default, f"{o.name}: default {o.default!r} rejected"
+        assert o.doc, f"{o.name} has no description"
+    defaults = cls.parse_options({})
+    assert defaults == {o.name: o.default for o in cls.options}
+
+
+@pytest.mark.parametrize("kw, option", [
+    ({"time_limit": True}, "time_limit"), ({"time_limit": float("inf")}, "time_limit"),
+    ({"time_limit": float("nan")}, "time_limit"), ({"time_limit": -1.0}, "time_limit"),
+    ({"time_limit": 0}, "time_limit"), ({"time_limit": "5"}, "time_limit"),
+    ({"mip_gap": 1.0}, "mip_gap"), ({"mip_gap": -0.1}, "mip_gap"),
+    ({"mip_gap": float("nan")}, "mip_gap"), ({"mip_gap": True}, "mip_gap"),
+    ({"threads": 0}, "threads"), ({"threads": 2.0}, "threads"), ({"threads": True}, "threads"),
+    ({"verbose": 1}, "verbose"),
+])
+def test_common_options_checked_in_one_place(kw, option):
+    from assocopt.solvers import OptionError
+
+    value = repr(next(iter(kw.values())))
+    p = AssignmentProblem.dense(np.ones((2, 2)))
+    for call in (lambda: solve(p, "highs", **kw), lambda: SolveOptions(**kw),
+                 lambda: solve(AssignmentProblem.dense(np.zeros((0, 0))), "greedy", **kw)):
+        with pytest.raises(OptionError) as info:
+            call()
+        assert info.value.option == option
+        assert str(info.value).startswith(f"{option} must be ") and value in str(info.value)
+
+
+def test_parsed_options_are_recorded():
+    p = AssignmentProblem.dense(np.random.default_rng(0).random((3, 3, 3)))
+    sol = solve(p, "bruteforce", max_nodes=10_000)
+    assert sol.info["options"] == {"max_nodes": 10_000}
+    sol = solve(p, "bnb", max_iter=7)
+    assert sol.info["options"]["max_iter"] == 7 and sol.info["options"]["fallback"] is True
+
+
+def _subclasses(cls):
+    for sub in cls.__subclasses__():
+        yield sub
+        yield from _subclasses(sub)
+
+
+def test_every_backend_subclass_is_registered():
+    import assocopt.solvers  # noqa: F401  (imports every back end module)
+
+    found = {sub for sub in _subclasses(Backend) if sub.__module__.startswith("assocopt.")}
+    concrete = {sub for sub in found if not sub.__name__.startswith("_")}
+    assert concrete, "no back end classes found"
+    for sub in concrete:
+        assert sub.name, f"{sub.__name__} has no name"
+        assert registered().get(sub.name) is sub, f"{sub.__name__} ({sub.name}) is not registered"
+    assert set(registered().values()) == concrete
+
+
+# ------------------------------------------------------------ honest reports
+def test_fallback_names_the_method_that_answered():
+    p = AssignmentProblem.dense(np.random.default_rng(3).random((7, 7, 7)))
+    sol = solve(p, "bnb", max_nodes=1, probe_every=0, max_iter=1, recover_every=0)
+    assert_optimal(p, sol)
+    assert sol.solver == "lagrangian-exact"
+    assert sol.info["requested"] == "bnb" and sol.info["fallback"] == "node budget spent"
+    import assocopt
+    assert sol.solver_version == assocopt.__version__
+
+
+def test_own_methods_report_assocopts_version():
+    import assocopt
+    for name in ("bnb", "lagrangian", "lagrangian-exact", "bruteforce", "greedy"):
+        assert registered()[name].version() == assocopt.__version__, name
