@@ -64,7 +64,10 @@ class Solution:
         The chosen tuples in S-D convention (0 = dummy, real indices 1-based),
         slack candidates left out.  See :meth:`assignment` for 0-based arrays.
     solver : str
-        Back end name; ``solver_version`` its package version.
+        The method that produced the answer: the back end asked for, or, when it
+        handed the problem on (``bnb``'s fallback), the one that answered, with
+        ``info["requested"]`` and ``info["fallback"]`` saying so.  ``solver_version``:
+        assocopt's version for assocopt's own methods, else the solver package's.
     times : dict
         ``build`` (model construction), ``solve`` (back end) and ``total`` seconds.
     relaxation : str or None

@@ -61,6 +61,10 @@ def _build_parser() -> argparse.ArgumentParser:
     pl = sub.add_parser("solvers", help="list the back ends and their capabilities",
                         description="List every registered back end, installed or not.")
     pl.add_argument("--json", action="store_true", help="print JSON")
+    pl.add_argument("--options", metavar="NAME", default=None,
+                    help="print the options back end NAME takes ('all': every back end)")
+    pl.add_argument("--markdown", action="store_true",
+                    help="with --options all: print the page docs/solver-options.md")
     _add_more_parsers(sub, FORMATS)
     return parser
 

@@ -103,7 +103,53 @@ def _solver_rows() -> list[dict[str, Any]]:
     return rows
 
 
+def _option_rows(name: str) -> dict[str, Any]:
+    from ..solvers import get_backend
+
+    cls = get_backend(name)
+    return {"name": cls.name, "native_options": cls.native_options or None,
+            "options": [{"name": o.name, "kind": o.kind, "accepts": o.describe(),
+                         "default": o.default, "description": o.doc}
+                        for o in cls.options]}
+
+
+def _cmd_options(args: argparse.Namespace, out: TextIO) -> int:
+    """``assocopt solvers --options NAME``: the declared options, as a table."""
+    from ..solvers import registered
+    from ..solvers.options import COMMON_NAMES, options_page, options_table
+
+    if args.markdown:
+        if args.options != "all":
+            raise AssocoptError("--markdown prints the page of every back end: "
+                                "use --options all --markdown")
+        print(options_page(), end="", file=out)
+        return EXIT_OK
+    names = sorted(registered()) if args.options == "all" else [args.options]
+    docs = [_option_rows(n) for n in names]
+    if args.json:
+        print(json.dumps(docs if args.options == "all" else docs[0], indent=2), file=out)
+        return EXIT_OK
+    for i, name in enumerate(names):
+        cls = registered()[name]
+        if i:
+            print(file=out)
+        print(f"options of solver {name!r} (besides the common "
+              f"{', '.join(COMMON_NAMES)}):", file=out)
+        rows = options_table(cls)
+        if rows:
+            _table([("option", "accepts", "default", "description"), *rows], out)
+        else:
+            print("  none of its own", file=out)
+        if cls.native_options:
+            print(f"also: {cls.native_options}", file=out)
+    return EXIT_OK
+
+
 def _cmd_solvers(args: argparse.Namespace, out: TextIO, err: TextIO) -> int:
+    if args.options is not None or args.markdown:
+        if args.options is None:
+            raise AssocoptError("--markdown needs --options all")
+        return _cmd_options(args, out)
     rows = _solver_rows()
     if args.json:
         print(json.dumps(rows, indent=2), file=out)
