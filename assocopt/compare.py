@@ -27,13 +27,13 @@ from dataclasses import dataclass, field
 from typing import Any, Callable, Iterable, Sequence, TextIO
 
 from .errors import AssocoptError, SolverCapabilityError
-from .problem import AssignmentProblem
+from .problem import OPT_TOL, AssignmentProblem
 from .progress import Progress
 
 __all__ = ["Method", "CompareResult", "compare", "resolve_methods", "TOLERANCE", "COLUMNS"]
 
 #: Relative tolerance of the agreement with a recorded optimum.
-TOLERANCE = 1e-9
+TOLERANCE = OPT_TOL
 #: Columns of :meth:`CompareResult.to_csv` (and keys of every row).
 COLUMNS = ("instance", "sizes", "candidates", "method", "solver", "formulation", "status",
            "objective", "bound", "gap", "build_s", "solve_s", "total_s", "optimum",

@@ -76,7 +76,8 @@ def _gap_text(g: float | None) -> str:
 def _matches(objective: float | None, optimum: float | None) -> bool | None:
     if optimum is None or objective is None:
         return None
-    return abs(objective - optimum) <= 1e-9 * max(1.0, abs(optimum))
+    from ..problem import OPT_TOL      # imported here: the CLI starts without scipy
+    return abs(objective - optimum) <= OPT_TOL * max(1.0, abs(optimum))
 
 
 def _short_list(values: Sequence[int], limit: int = MAX_SHOWN) -> str:

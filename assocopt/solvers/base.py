@@ -146,6 +146,9 @@ class Backend:
     exact_float_costs: ClassVar[bool] = True
     options: ClassVar[tuple[Option, ...]] = ()
     native_options: ClassVar[str] = ""
+    #: The method is assocopt's own (its version is assocopt's, even when a package
+    #: such as numba runs it).
+    own_method: ClassVar[bool] = False
 
     @classmethod
     def is_native_option(cls, name: str) -> bool:
@@ -175,8 +178,12 @@ class Backend:
 
     @classmethod
     def version(cls) -> str:
-        """Version of the package doing the work ("" when not installed)."""
-        return _distribution_version(cls.distribution or "assocopt")
+        """Version of the method: assocopt's for its own methods, else that of the
+        package doing the work ("" when not installed)."""
+        if cls.own_method or cls.distribution is None:
+            from .. import __version__
+            return __version__
+        return _distribution_version(cls.distribution)
 
     @classmethod
     def require(cls) -> None:

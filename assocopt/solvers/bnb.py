@@ -180,12 +180,8 @@ class BranchBoundBackend(Backend):
                    "(numba; small S-D problems)")
     supports_time_limit = True
     options = OPTIONS
+    own_method = True        # numba only compiles it
 
-    @classmethod
-    def version(cls) -> str:
-        """assocopt's version: the method is assocopt's (numba only compiles it)."""
-        from .. import __version__
-        return __version__
 
     def solve(self, problem: AssignmentProblem, options: SolveOptions) -> RawResult:
         p = self.settings(problem, options)

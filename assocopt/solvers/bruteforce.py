@@ -110,10 +110,7 @@ class BruteForceBackend(Backend):
     options = (Option("max_nodes", "int", DEFAULT_MAX_NODES,
                       "search nodes; past them the search stops with time_limit", low=1),)
 
-    @classmethod
-    def version(cls) -> str:
-        from .. import __version__
-        return __version__
+    own_method = True
 
     def solve(self, problem: AssignmentProblem, options: SolveOptions) -> RawResult:
         from ..errors import ProblemTooLargeError

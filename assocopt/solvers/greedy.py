@@ -61,10 +61,7 @@ class GreedyBackend(Backend):
     exact = False
     gives_bound = False
 
-    @classmethod
-    def version(cls) -> str:
-        from .. import __version__
-        return __version__
+    own_method = True
 
     def solve(self, problem: AssignmentProblem, options: SolveOptions) -> RawResult:
         self.settings(problem, options)          # no options of its own: rejects any

@@ -37,7 +37,7 @@ class _State:
 
     def offer(self, positions: np.ndarray) -> None:
         vals = self.costs[positions]
-        if float(vals.sum()) > self.ub + 1e-9 * max(1.0, abs(self.ub)):
+        if float(vals.sum()) > self.ub + OPT_TOL * max(1.0, abs(self.ub)):
             return
         obj = math.fsum(vals.tolist())
         if obj < self.ub:

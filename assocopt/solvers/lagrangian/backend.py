@@ -40,10 +40,7 @@ class _LagrangianBase(Backend):
     supports_time_limit = True
     _exact: bool = False
 
-    @classmethod
-    def version(cls) -> str:
-        from ... import __version__
-        return __version__
+    own_method = True
 
     def solve(self, problem: AssignmentProblem, options: SolveOptions) -> RawResult:
         t_start = time.perf_counter()

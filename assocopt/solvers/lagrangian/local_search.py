@@ -11,6 +11,7 @@ import math
 
 import numpy as np
 
+from ...problem import OPT_TOL
 from ..lap import LapInfeasibleError, assign_with_misses
 
 
@@ -52,7 +53,7 @@ class _LocalSearch:
             new = self._axis(cur, s)
             if new is not None:
                 nc = float(c[new].sum())
-                if nc < cost - 1e-9 * max(1.0, abs(cost)):
+                if nc < cost - OPT_TOL * max(1.0, abs(cost)):
                     cur, cost, stale = new, nc, 0
                 else:
                     stale += 1
