@@ -69,7 +69,7 @@ import numpy as np
 from ..errors import ProblemTooLargeError
 from ..problem import AssignmentProblem
 from ..solution import Status
-from ..problem import OPT_TOL, kept_axes
+from ..problem import OPT_TOL
 from .base import (Backend, Option, RawResult, SolveOptions, _distribution_version,
                    empty_answer, get_backend, register)
 
@@ -90,7 +90,7 @@ MAX_KEPT = 400
 
 def kept_sizes(problem: AssignmentProblem, keep_axes: Any = None) -> tuple[int, int]:
     """``(n_a, n_b)``: the sizes of the two kept axes."""
-    a, b = _keep(problem.sizes, keep_axes)
+    a, b = problem.kept_axes(keep_axes)
     return problem.sizes[a], problem.sizes[b]
 
 
@@ -125,7 +125,7 @@ class BnbInput:
     def build(cls, problem: AssignmentProblem, keep_axes: Any = None) -> "BnbInput":
         from . import bnb_kernels as kern
 
-        a, b = _keep(problem.sizes, keep_axes)
+        a, b = problem.kept_axes(keep_axes)
         relaxed = np.array([s for s in range(problem.ndim) if s not in (a, b)],
                            dtype=np.int64)
         c = np.ascontiguousarray(problem.costs, np.float64)
@@ -135,11 +135,6 @@ class BnbInput:
         return cls(G=G, c=c, a=a, b=b, relaxed=relaxed, off=problem.row_offsets,
                    plain=bool(plain), axis_of=axis_of, ptr=ptr, lst=lst,
                    int_costs=bool(int_costs), y0=y0)
-
-
-def _keep(sizes: tuple[int, ...], keep_axes: Any) -> tuple[int, int]:
-    """The two kept axes: given, or the two largest (see :func:`assocopt.problem.kept_axes`)."""
-    return kept_axes(sizes, keep_axes)
 
 
 OPTIONS: tuple[Option, ...] = (

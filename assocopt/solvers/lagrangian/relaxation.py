@@ -17,7 +17,6 @@ from ...errors import InvalidProblemError
 from ...problem import AssignmentProblem
 from ..lap import (Assignment2D, LapInfeasibleError, assign_with_misses, assignment_duals,
                    linear_assignment)
-from .options import _keep_axes
 
 
 def _ranges(starts: np.ndarray, counts: np.ndarray) -> np.ndarray:
@@ -344,7 +343,7 @@ def lagrangian_bound(problem: AssignmentProblem, multipliers: dict[int, np.ndarr
     >>> lagrangian_bound(p, {2: np.array([5.0, -5.0])}) <= 7.0
     True
     """
-    keep = _keep_axes(problem.sizes, keep_axes)
+    keep = problem.kept_axes(keep_axes)
     rel = _Relaxation(problem.sizes, problem.tuples, problem.costs, keep, "auto")
     upad = np.zeros(rel.u_len)
     for t, r in enumerate(rel.relaxed):
