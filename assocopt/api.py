@@ -2,7 +2,6 @@
 
 from __future__ import annotations
 
-import dataclasses
 import time
 from typing import Any
 
@@ -94,14 +93,16 @@ def solve(problem: AssignmentProblem, solver: str = "auto", *, relax: str | None
     if not isinstance(problem, AssignmentProblem):
         raise InvalidProblemError(
             f"problem must be an AssignmentProblem, got {type(problem).__name__}")
-    common = SolveOptions(relax=relax, time_limit=time_limit, mip_gap=mip_gap,
-                          threads=threads, verbose=verbose)     # checks the common options
+    if relax not in (None, "lp"):
+        raise InvalidProblemError(f"relax must be None or 'lp', got {relax!r}")
     name = choose_solver(problem, relax) if solver == "auto" else solver
     backend_cls = get_backend(name)
     check_capabilities(backend_cls, problem, relax)
     backend_cls.require()
     parsed = backend_cls.parse_options(options)
-    opts = dataclasses.replace(common, extra=parsed, parsed=True)
+    # SolveOptions checks the common options (the one place that does)
+    opts = SolveOptions(relax=relax, time_limit=time_limit, mip_gap=mip_gap,
+                        threads=threads, verbose=verbose, extra=parsed, parsed=True)
 
     missing = problem.uncovered()
     if missing:

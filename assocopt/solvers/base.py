@@ -64,6 +64,9 @@ class SolveOptions:
     def __post_init__(self) -> None:
         if self.relax not in (None, "lp"):
             raise InvalidProblemError(f"relax must be None or 'lp', got {self.relax!r}")
+        if self.time_limit is None and self.threads is None and self.verbose is False \
+                and type(self.mip_gap) is float and self.mip_gap == 0.0:
+            return                         # the defaults: the hot path of small solves
         values = check_common(self.time_limit, self.mip_gap, self.threads, self.verbose)
         for name, value in zip(("time_limit", "mip_gap", "threads", "verbose"), values):
             object.__setattr__(self, name, value)

@@ -193,6 +193,9 @@ def check_common(time_limit: Any = None, mip_gap: Any = 0.0, threads: Any = None
                  verbose: Any = False) -> tuple[float | None, float, int | None, bool]:
     """The common options checked and normalised; :class:`OptionError` names the
     option and the value (``time_limit=True``, ``mip_gap=1.5``, ``threads=2.0``...)."""
+    if time_limit is None and threads is None and verbose is False and \
+            type(mip_gap) in (float, int) and mip_gap == 0:
+        return None, 0.0, None, False       # the defaults: the hot path of small solves
     values = {"time_limit": time_limit, "mip_gap": mip_gap, "threads": threads,
               "verbose": verbose}
     out = []
@@ -211,8 +214,10 @@ def parse_options(backend: type["Backend"], given: Mapping[str, Any]) -> dict[st
     Raises :class:`OptionError` (an :class:`~assocopt.errors.InvalidProblemError`) for
     an unknown name or a bad value, with one wording for every back end.
     """
-    declared = {o.name: o for o in backend.options}
-    out = {name: o.default for name, o in declared.items()}
+    declared, defaults, mutable = _declared(backend)
+    out = dict(defaults)
+    for key in mutable:                   # a fresh copy of a mutable default
+        out[key] = dict(out[key])
     for key, value in given.items():
         opt = declared.get(key)
         if opt is None:
@@ -226,6 +231,23 @@ def parse_options(backend: type["Backend"], given: Mapping[str, Any]) -> dict[st
             raise OptionError(f"solver {backend.name!r}: option {key} {exc}", key,
                               str(exc)) from None
     return out
+
+
+_DECLARED: dict[type, tuple[Any, ...]] = {}
+
+
+def _declared(backend: type["Backend"]
+              ) -> tuple[dict[str, Option], dict[str, Any], tuple[str, ...]]:
+    """``backend``'s options by name, their defaults and the names of the mutable
+    ones (cached per class while its declaration is the same object: options are
+    parsed on every solve)."""
+    hit = _DECLARED.get(backend)
+    if hit is None or hit[0] is not backend.options:
+        opts = backend.options
+        hit = _DECLARED[backend] = (opts, {o.name: o for o in opts},
+                                    {o.name: o.default for o in opts},
+                                    tuple(o.name for o in opts if isinstance(o.default, dict)))
+    return hit[1], hit[2], hit[3]
 
 
 def unknown_message(backend: type["Backend"], key: Any) -> str:
