@@ -21,6 +21,7 @@ from hypothesis import strategies as st
 from assocopt import (AssignmentProblem, InvalidProblemError, SolverNotInstalledError,
                       Status, choose_solver, solve)
 from assocopt.solvers import lagrangian as lg
+from assocopt.solvers import registered
 from assocopt.solvers.lap import (LapInfeasibleError, assign_with_misses,
                                   assignment_duals, lapx_available, linear_assignment)
 from assocopt.testing import assert_feasible, assert_optimal, random_problem
@@ -441,3 +442,29 @@ def _tracking(rng, N, n_targets, pd=0.9, clutter=1.0, sigma=0.02, gate=0.12):
         cost[k] = 0.5 * resid - nreal[k] * math.log(pd / (2 * math.pi * sigma ** 2 * clutter)) \
             - (N - nreal[k]) * math.log(1 - pd)
     return AssignmentProblem.sparse(sizes, T, cost)
+
+
+@pytest.mark.parametrize("window_solver", ["cpsat", "highs"])
+def test_window_results_use_one_vocabulary_whichever_engine_ran(monkeypatch, window_solver):
+    """The window search reports what each window settled in the engines' common
+    terms (not HiGHS's status names when CP-SAT ran); HiGHS's own status, when HiGHS
+    ran, is kept apart as ``native``."""
+    if window_solver == "cpsat" and not registered()["ortools-cpsat"].is_available():
+        pytest.skip("ortools not installed")
+    from assocopt.solvers.lagrangian import backend as lag_backend
+    from assocopt.solvers.lagrangian.window import Outcome
+
+    monkeypatch.setattr(lag_backend, "_has_numba", lambda: False)   # no compiled search
+    monkeypatch.setattr(lag_backend, "_SEARCH_MAX", 0)              # no Python search
+    p = AssignmentProblem.dense(np.random.default_rng(0).integers(0, 20, (8, 8, 8))
+                                .astype(float))
+    sol = solve(p, "lagrangian-exact", window_solver=window_solver, max_iter=5)
+    assert_optimal(p, sol)
+    ran = [w for w in sol.info["windows"] if "solver" in w]
+    assert ran, "no window reached an engine"
+    outcomes = {o.value for o in Outcome}
+    for w in ran:
+        assert w["solver"] == window_solver and w["result"] in outcomes, w
+        assert ("native" in w) == (window_solver == "highs"), w
+        if window_solver == "highs":
+            assert w["native"].startswith("k")

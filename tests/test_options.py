@@ -137,3 +137,32 @@ def test_model_options_checked_without_a_trial_solve(tmp_path, monkeypatch):
     with pytest.raises(ModelError, match="options.fallback: rejected by back end 'bnb': "
                                          ".*must be True or False, got 1"):
         load_model(str(bad))
+
+
+# ------------------------------------------------------------------ status rule
+@pytest.mark.parametrize("status, gap, mip_gap, claim_tol, expected", [
+    ("optimal", 0.0, 0.0, None, "optimal"),
+    ("optimal", 0.5, 0.0, None, "optimal"),        # no tolerance asked: the claim stands
+    ("optimal", 0.5, 0.0, 1e-6, "feasible"),       # ... unless its own bound says no
+    ("optimal", 1e-7, 0.0, 1e-6, "optimal"),
+    ("optimal", 1e-10, 0.1, None, "optimal"),      # reached gap is round-off
+    ("optimal", 1e-3, 0.1, None, "feasible"),      # stopped at the requested gap
+    ("optimal", None, 0.1, None, "feasible"),      # no bound: nothing proven
+    ("time_limit", 0.0, 0.1, None, "time_limit"),
+    ("infeasible", None, 0.0, 1e-6, "infeasible"),
+])
+def test_settle_optimal_is_the_one_rule(status, gap, mip_gap, claim_tol, expected):
+    from assocopt import Status
+    from assocopt.solvers.status import settle_optimal
+
+    got, note = settle_optimal(Status(status), gap, mip_gap, claim_tol=claim_tol)
+    assert got is Status(expected)
+    assert (note != "") == (status == "optimal" and expected == "feasible")
+
+
+def test_backends_map_statuses_through_tables():
+    from assocopt.solvers import cvxpy_backend, highs, ortools_cpsat, ortools_mip, scipy_milp
+
+    for module in (highs, scipy_milp, ortools_cpsat, ortools_mip, cvxpy_backend):
+        table = module._STATUS_TABLE
+        assert table and all(isinstance(k, str) for k in table), module.__name__
