@@ -30,16 +30,12 @@ from dataclasses import dataclass, field
 from typing import Any, Sequence
 
 import numpy as np
-import scipy.sparse as sp
 from numpy.typing import ArrayLike
 
 from .errors import InvalidProblemError
+from .indexing import OPT_TOL, IndexArithmetic, index_label, kept_axes
 
 __all__ = ["AssignmentProblem", "OPT_TOL", "kept_axes", "index_label"]
-
-#: Relative tolerance of "a bound meets an objective" for non-integer costs
-#: (floating-point round-off): the one tolerance the exact back ends share.
-OPT_TOL = 1e-9
 
 #: Largest number of candidates a dense constructor will enumerate.
 MAX_DENSE_CANDIDATES = 50_000_000
@@ -60,39 +56,13 @@ def _as_cost_array(values: ArrayLike, what: str) -> np.ndarray:
     return arr
 
 
-def index_label(axis: int, index: int) -> str:
-    """``"index i of axis s"`` with the conventions spelled out (axis 0-based, index 1-based)."""
-    return f"real index {index} (1-based) of axis {axis} (0-based)"
-
-
-def kept_axes(sizes: Sequence[int], keep: Any = None) -> tuple[int, int]:
-    """The two axes a Lagrangian relaxation keeps, sorted: ``keep`` checked, or by
-    default the two largest (the lower axis number first on ties).
-
-    >>> kept_axes((3, 5, 4)), kept_axes((3, 5, 4), keep=(2, 0))
-    ((1, 2), (0, 2))
-    """
-    N = len(sizes)
-    if keep is None:
-        order = sorted(range(N), key=lambda s: (-sizes[s], s))
-        return min(order[:2]), max(order[:2])
-    try:
-        a, b = (int(v) for v in keep)
-    except (TypeError, ValueError):
-        raise InvalidProblemError(f"keep_axes must be two axis numbers, got {keep!r}") from None
-    if not (0 <= a < N and 0 <= b < N and a != b):
-        raise InvalidProblemError(f"keep_axes must be two different axes in 0..{N - 1}, "
-                                  f"got {keep!r}")
-    return min(a, b), max(a, b)
-
-
 def _freeze(arr: np.ndarray) -> np.ndarray:
     arr.setflags(write=False)
     return arr
 
 
 @dataclass(frozen=True, eq=False)
-class AssignmentProblem:
+class AssignmentProblem(IndexArithmetic):
     """A validated S-D assignment problem (see the module docstring for the model).
 
     Build it with :meth:`dense`, :meth:`two_d` or :meth:`sparse`, not directly.
@@ -311,67 +281,6 @@ class AssignmentProblem:
         off = np.concatenate([[0], np.cumsum(self.sizes)[:-1]]).astype(np.int64)
         off.setflags(write=False)
         return off
-
-    def rows_of(self, tuples: np.ndarray) -> np.ndarray:
-        """Global constraint row of every entry of ``tuples`` (shape (k, N)), ``-1``
-        for dummies: row ``offset_s + i - 1`` stands for real index ``i`` of axis s."""
-        T = np.asarray(tuples, dtype=np.int64)
-        return np.where(T > 0, T - 1 + self.row_offsets[None, :], -1)
-
-    @functools.cached_property
-    def entry_rows(self) -> np.ndarray:
-        """:meth:`rows_of` the candidate tuples, ``(K, N)``, read-only (cached)."""
-        return _freeze(self.rows_of(self.tuples))
-
-    def coverage_matrix(self, pos: ArrayLike | None = None) -> sp.csr_matrix:
-        """CSR matrix ``A`` (sum n_s x K): ``A[r, k] = 1`` if candidate k covers row r.
-
-        With ``pos``, the columns of those candidates only (a window of them).
-        Row ``offset_s + i - 1`` stands for real index ``i`` of axis ``s``.
-        Built in bulk from the tuple array.
-        """
-        R = self.entry_rows if pos is None else self.entry_rows[np.asarray(pos, np.int64)]
-        real = R >= 0
-        cols = np.broadcast_to(np.arange(len(R))[:, None], R.shape)[real]
-        A = sp.csr_matrix((np.ones(len(cols)), (R[real], cols)),
-                          shape=(self.n_rows, len(R)))
-        A.sort_indices()
-        return A
-
-    def uncovered_rows(self, pos: ArrayLike | None = None) -> np.ndarray:
-        """Constraint rows that no candidate (of ``pos``, if given) covers."""
-        R = self.entry_rows if pos is None else self.entry_rows[np.asarray(pos, np.int64)]
-        return np.flatnonzero(np.bincount(R[R >= 0], minlength=self.n_rows) == 0)
-
-    def uncovered(self) -> list[tuple[int, int]]:
-        """Real indices ``(axis, index)`` that no candidate covers (1-based index).
-
-        Any such index makes the problem infeasible.
-        """
-        return list(self._uncovered)
-
-    @functools.cached_property
-    def _uncovered(self) -> tuple[tuple[int, int], ...]:
-        return tuple(self.axis_index(int(r)) for r in self.uncovered_rows())
-
-    def axis_index(self, row: int) -> tuple[int, int]:
-        """``(axis, real index)`` (index 1-based) of constraint row ``row``."""
-        a = int(np.searchsorted(self.row_offsets, row, side="right") - 1)
-        return a, int(row - self.row_offsets[a] + 1)
-
-    def kept_axes(self, keep: Any = None) -> tuple[int, int]:
-        """The two kept axes of a Lagrangian relaxation (see :func:`kept_axes`)."""
-        return kept_axes(self.sizes, keep)
-
-    @functools.cached_property
-    def integer_costs(self) -> bool:
-        """Whether every cost is an integer small enough to be exact in float64."""
-        c = self.costs
-        return bool(np.all(c == np.round(c)) and np.abs(c).max(initial=0) < 2 ** 52)
-
-    def row_label(self, row: int) -> str:
-        """Human-readable name of constraint row ``row``: its axis and real index."""
-        return index_label(*self.axis_index(row))
 
     # ------------------------------------------------------------- solutions
     def violations(self, selected: ArrayLike) -> str | None:

@@ -1,0 +1,132 @@
+"""Index arithmetic of an assignment problem, in one place for every back end.
+
+A problem with axes of sizes ``n_1 .. n_N`` has one coverage constraint ("row") per
+real index: row ``offset_s + i - 1`` stands for real index ``i`` (1-based) of axis
+``s`` (0-based), ``offset_s = n_1 + ... + n_{s-1}``.  :class:`IndexArithmetic` gives
+:class:`~assocopt.problem.AssignmentProblem` the global row of every tuple entry, the
+coverage matrix (of all candidates or a window of them), the uncovered rows and
+indices, their labels, the kept-axes rule of the Lagrangian relaxations and whether
+the costs are integers; :data:`OPT_TOL` is the one relative tolerance of "a bound
+meets an objective".  Back ends use these instead of their own copies.
+"""
+
+from __future__ import annotations
+
+import functools
+from typing import TYPE_CHECKING, Any, Sequence
+
+import numpy as np
+from numpy.typing import ArrayLike
+
+from .errors import InvalidProblemError
+
+if TYPE_CHECKING:   # pragma: no cover
+    import scipy.sparse as sp
+
+__all__ = ["OPT_TOL", "IndexArithmetic", "index_label", "kept_axes"]
+
+#: Relative tolerance of "a bound meets an objective" for non-integer costs
+#: (floating-point round-off): the one tolerance the exact back ends share.
+OPT_TOL = 1e-9
+
+
+def index_label(axis: int, index: int) -> str:
+    """``"index i of axis s"`` with the conventions spelled out (axis 0-based, index 1-based)."""
+    return f"real index {index} (1-based) of axis {axis} (0-based)"
+
+
+def kept_axes(sizes: Sequence[int], keep: Any = None) -> tuple[int, int]:
+    """The two axes a Lagrangian relaxation keeps, sorted: ``keep`` checked, or by
+    default the two largest (the lower axis number first on ties).
+
+    >>> kept_axes((3, 5, 4)), kept_axes((3, 5, 4), keep=(2, 0))
+    ((1, 2), (0, 2))
+    """
+    N = len(sizes)
+    if keep is None:
+        order = sorted(range(N), key=lambda s: (-sizes[s], s))
+        return min(order[:2]), max(order[:2])
+    try:
+        a, b = (int(v) for v in keep)
+    except (TypeError, ValueError):
+        raise InvalidProblemError(f"keep_axes must be two axis numbers, got {keep!r}") from None
+    if not (0 <= a < N and 0 <= b < N and a != b):
+        raise InvalidProblemError(f"keep_axes must be two different axes in 0..{N - 1}, "
+                                  f"got {keep!r}")
+    return min(a, b), max(a, b)
+
+
+class IndexArithmetic:
+    """Mixin of :class:`~assocopt.problem.AssignmentProblem`: needs ``sizes``,
+    ``tuples``, ``costs``, ``n_rows`` and ``row_offsets``."""
+
+    sizes: tuple[int, ...]
+    tuples: np.ndarray
+    costs: np.ndarray
+    n_rows: int
+    row_offsets: np.ndarray
+
+    def rows_of(self, tuples: np.ndarray) -> np.ndarray:
+        """Global constraint row of every entry of ``tuples`` (shape (k, N)), ``-1``
+        for dummies: row ``offset_s + i - 1`` stands for real index ``i`` of axis s."""
+        T = np.asarray(tuples, dtype=np.int64)
+        return np.where(T > 0, T - 1 + self.row_offsets[None, :], -1)
+
+    @functools.cached_property
+    def entry_rows(self) -> np.ndarray:
+        """:meth:`rows_of` the candidate tuples, ``(K, N)``, read-only (cached)."""
+        rows = self.rows_of(self.tuples)
+        rows.setflags(write=False)
+        return rows
+
+    def coverage_matrix(self, pos: ArrayLike | None = None) -> "sp.csr_matrix":
+        """CSR matrix ``A`` (sum n_s x K): ``A[r, k] = 1`` if candidate k covers row r.
+
+        With ``pos``, the columns of those candidates only (a window of them).
+        Row ``offset_s + i - 1`` stands for real index ``i`` of axis ``s``.
+        Built in bulk from the tuple array.
+        """
+        import scipy.sparse as sp     # here: importing assocopt need not load scipy
+
+        R = self.entry_rows if pos is None else self.entry_rows[np.asarray(pos, np.int64)]
+        real = R >= 0
+        cols = np.broadcast_to(np.arange(len(R))[:, None], R.shape)[real]
+        A = sp.csr_matrix((np.ones(len(cols)), (R[real], cols)),
+                          shape=(self.n_rows, len(R)))
+        A.sort_indices()
+        return A
+
+    def uncovered_rows(self, pos: ArrayLike | None = None) -> np.ndarray:
+        """Constraint rows that no candidate (of ``pos``, if given) covers."""
+        R = self.entry_rows if pos is None else self.entry_rows[np.asarray(pos, np.int64)]
+        return np.flatnonzero(np.bincount(R[R >= 0], minlength=self.n_rows) == 0)
+
+    def uncovered(self) -> list[tuple[int, int]]:
+        """Real indices ``(axis, index)`` that no candidate covers (1-based index).
+
+        Any such index makes the problem infeasible.
+        """
+        return list(self._uncovered)
+
+    @functools.cached_property
+    def _uncovered(self) -> tuple[tuple[int, int], ...]:
+        return tuple(self.axis_index(int(r)) for r in self.uncovered_rows())
+
+    def axis_index(self, row: int) -> tuple[int, int]:
+        """``(axis, real index)`` (index 1-based) of constraint row ``row``."""
+        a = int(np.searchsorted(self.row_offsets, row, side="right") - 1)
+        return a, int(row - self.row_offsets[a] + 1)
+
+    def kept_axes(self, keep: Any = None) -> tuple[int, int]:
+        """The two kept axes of a Lagrangian relaxation (see :func:`kept_axes`)."""
+        return kept_axes(self.sizes, keep)
+
+    @functools.cached_property
+    def integer_costs(self) -> bool:
+        """Whether every cost is an integer small enough to be exact in float64."""
+        c = self.costs
+        return bool(np.all(c == np.round(c)) and np.abs(c).max(initial=0) < 2 ** 52)
+
+    def row_label(self, row: int) -> str:
+        """Human-readable name of constraint row ``row``: its axis and real index."""
+        return index_label(*self.axis_index(row))
