@@ -42,8 +42,8 @@ the states after stage 2 as printed (``score="final"``) or, as our variant, over
 stage-1 states (``score="initial"``: stage 2 inflates the states it pushes to "on",
 so a contradictory record can outscore a consistent one).
 
-Everything is vectorised over reports and records: stage 2 runs every unsettled
-(report, record) pair at once.
+Stage 1 is vectorised over reports and records; stage 2 runs every unsettled
+(report, record) column through one compiled (numba) loop.
 
 Examples
 --------
@@ -61,6 +61,7 @@ from dataclasses import dataclass, asdict
 from typing import Any
 
 import numpy as np
+from numba import njit
 from numpy.typing import ArrayLike
 
 __all__ = ["DIDParams", "DIDResult", "ERRORS", "SELECTS", "UNRESOLVED", "relative_errors",
@@ -238,33 +239,50 @@ def stage2(s_on: ArrayLike, B: np.ndarray, max_iter: int, select: str = "movable
     updates.
     """
     s = np.array(s_on, dtype=np.float64)
-    P, m = s.shape
-    iters = np.zeros(P, dtype=np.int64)
-    stalled = np.zeros(P, dtype=bool)
-    rows = np.arange(P)
-    for _ in range(max_iter):
-        on = dominance(s)
-        active = ~(on.all(axis=1) | (~on).all(axis=1)) & ~stalled
-        if not active.any():
-            break
-        idx = rows[active]
-        sa = s[idx]
-        y = (sa - (1.0 - sa)) @ B.T                 # y[p, i] = sum_l B[i, l] (s_on - s_off)
-        t = np.abs(sa - 0.5)
-        if select == "movable":
-            can = ((y > 0) & (sa < 1.0)) | ((y < 0) & (sa > 0.0))
-            t = np.where(can, t, np.inf)
-        istar = np.argmin(t, axis=1)
-        old = sa[np.arange(len(idx)), istar]
-        new = np.clip(old + y[np.arange(len(idx)), istar], 0.0, 1.0)
-        stuck = (new == old) | ~np.isfinite(t[np.arange(len(idx)), istar])
-        stalled[idx[stuck]] = True
-        move = ~stuck
-        s[idx[move], istar[move]] = new[move]
-        iters[idx[move]] += 1
+    if s.ndim != 2:
+        raise ValueError(f"stage-2 columns must have shape (P, m), got {s.shape}")
+    iters = _stage2_kernel(s, np.ascontiguousarray(B, dtype=np.float64), int(max_iter),
+                           select == "movable")
     on = dominance(s)
     settled = on.all(axis=1) | (~on).all(axis=1)
     return s, settled, iters
+
+
+@njit(cache=True)
+def _stage2_kernel(s, B, max_iter, movable):            # pragma: no cover - compiled
+    """In place: the stage-2 loop of every column (row) of ``s``; returns the updates."""
+    P, m = s.shape
+    iters = np.zeros(P, np.int64)
+    y = np.empty(m)
+    for p in range(P):
+        for _ in range(max_iter):
+            n_on = 0
+            for i in range(m):
+                if s[p, i] >= 1.0 - s[p, i]:
+                    n_on += 1
+            if n_on == 0 or n_on == m:
+                break                                   # the factors agree: settled
+            for i in range(m):
+                acc = 0.0
+                for l in range(m):
+                    if l != i:
+                        acc += B[i, l] * (s[p, l] - (1.0 - s[p, l]))
+                y[i] = acc
+            best, bt = -1, np.inf
+            for i in range(m):
+                if movable and not ((y[i] > 0 and s[p, i] < 1.0) or (y[i] < 0 and s[p, i] > 0.0)):
+                    continue
+                t = abs(s[p, i] - 0.5)
+                if t < bt:
+                    best, bt = i, t
+            if best < 0:
+                break                                   # nothing can move: stalled
+            new = min(max(s[p, best] + y[best], 0.0), 1.0)
+            if new == s[p, best]:
+                break                                   # the chosen factor is stuck
+            s[p, best] = new
+            iters[p] += 1
+    return iters
 
 
 @dataclass(frozen=True)
