@@ -295,3 +295,87 @@ def test_gnn_tracker_gives_no_track_two_reports_in_a_scan():
     for source, went, _, new in log.scans:
         assoc = [t for w in went for t in w if t not in new]
         assert len(assoc) == len(set(assoc))
+
+
+# ------------------------------------------------------------- reproduction
+SMALL = {"n_scans": 12, "clutter_mean": 5.0}
+
+
+def test_pinned_small_seeded_run():
+    from assocopt.experiments import trial_seed
+    from assocopt.reproduce import xue1999 as repro
+    exp = repro.experiments(1, 0, SMALL, parts=("main",))[0]
+    s = exp.settings[0]
+    res = repro.trial(s, exp.methods, trial_seed(0, s, 0))
+    pinned = {"did": (35 / 44, 0, 1, 0.5, 2 / 97), "did-literal": (8 / 11, 0, 0, 0.5, 1.0),
+              "did-origin": (31 / 44, 0, 0, 1.0, 3 / 97), "did-q0": (1.0, 0, 0, 1.0, 2 / 97),
+              "gnn": (1.0, 0, 0, 1.0, None), "nn": (1.0, 0, 0, 1.0, None)}
+    for m, (rate, swaps, false, held, nonconv) in pinned.items():
+        r = res[m]
+        assert r["correct_rate"] == pytest.approx(rate), m
+        assert (r["swaps"], r["false_tracks"], r["held_at_end"]) == (swaps, false, held), m
+        assert r.get("nonconverged_rate") == (None if nonconv is None else pytest.approx(nonconv))
+
+
+def test_reproduction_writes_summary_figures_and_resumes(tmp_path):
+    from assocopt.reproduce import xue1999 as repro
+    opts = {**SMALL, "noise_grid": (1.0, 2.0), "clutter_grid": (0.0,), "sweep_divisor": 1}
+    printed = []
+    s = repro.run(2, 1, 3, tmp_path, options=opts, echo=printed.append)
+    data = json.loads((tmp_path / "summary.json").read_text())
+    assert data["paper"] == "xue1999" and data["runs"] == 2
+    assert {r["experiment"] for r in data["records"]} == {"main", "sweep"}
+    assert all(r["runs"] == 2 for r in data["records"] if r["metric"] == "correct_rate")
+    assert "did_scale" in data["parameters"]["ours"]["ours"]
+    assert "Base scene" in printed[0] and "Sweep: correct association rate" in printed[0]
+    for f in s["figures"]:
+        assert (tmp_path / f).stat().st_size > 0
+    again = repro.run(2, 1, 3, tmp_path, options=opts, echo=lambda t: None)
+    assert all(v["done"] == 0 for v in again["timing"].values())
+    stable = lambda recs: sorted((json.dumps(r["setting"], sort_keys=True), r["method"],
+                                  r["metric"], r["value"]) for r in recs if not r["volatile"])
+    assert stable(again["records"]) == stable(s["records"])
+
+
+@pytest.mark.slow
+def test_reproduction_same_numbers_with_two_workers(tmp_path):
+    from assocopt.reproduce import xue1999 as repro
+    opts = {**SMALL, "n_scans": 8, "main_methods": ("did", "gnn")}
+    one = repro.run(3, 1, 5, tmp_path / "a", options=opts, parts=("main",), echo=lambda t: None)
+    two = repro.run(3, 2, 5, tmp_path / "b", options=opts, parts=("main",), echo=lambda t: None)
+    pick = lambda s: sorted((r["method"], r["metric"], r["value"]) for r in s["records"]
+                            if not r["volatile"])
+    assert pick(one) == pick(two)
+
+
+def test_reproduction_rejects_unknown_options_and_methods():
+    from assocopt.reproduce import xue1999 as repro
+    with pytest.raises(ValueError, match="unknown xue1999 option"):
+        repro.experiments(2, 0, {"bogus": 1})
+    with pytest.raises(ValueError, match="unknown xue1999 method"):
+        repro.experiments(2, 0, {"sweep_methods": ("jpda",)})
+
+
+# ------------------------------------------------------------- the page
+PAGE = ROOT / "docs" / "papers" / "xue1999.md"
+SUMMARY = ROOT / "docs" / "papers" / "xue1999" / "summary.json"
+
+
+def _block(text: str, name: str) -> str:
+    m = re.search(rf"<!-- {name}:begin -->\n(.*?)\n<!-- {name}:end -->", text, re.DOTALL)
+    assert m, f"the page has no generated block {name!r}"
+    return m.group(1).strip()
+
+
+def test_page_tables_match_the_committed_summary():
+    from assocopt.reproduce import xue1999 as repro
+    summary = json.loads(SUMMARY.read_text())
+    text = PAGE.read_text(encoding="utf-8")
+    assert _block(text, "tables") == repro.render_tables(summary).strip()
+    assert _block(text, "parameters") == repro.render_parameters(summary).strip()
+    assert _block(text, "headline") == repro.render_headline(summary).strip()
+    assert summary["parameters"] == json.loads(json.dumps(repro.parameters()))  # current defaults
+    assert summary["runs"] == 200 and summary["seed"] == 0
+    for f in summary["figures"]:
+        assert (SUMMARY.parent / f).is_file() and f"xue1999/{f}" in text
+    assert not re.search(r"SPEC|E3\.\d|TRAPS", text)

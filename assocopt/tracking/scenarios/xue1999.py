@@ -5,9 +5,11 @@ crossings and strong noise (its Figs. 2-3) and gives no parameter at all.  Every
 here is **ours**, a named field of :class:`Xue1999` (:data:`OURS` lists them):
 
 * four constant-velocity targets over ``n_scans`` scans of period ``T``: targets 0
-  and 1 cross at a shallow angle (22.6 degrees) at scan 20 and share their IFF
-  attribute, targets 2 and 3 cross at 43.6 degrees at scan 30 with different IFF, and
-  the lines of 0/1 and 2/3 cross each other at other times (six crossings in all);
+  and 1 meet at (5, 5) km at scan 20 (crossing angle 32 degrees) and share their IFF
+  attribute, targets 2 and 3 meet at (5, 7.5) km at scan 30 (51 degrees) with different
+  IFF, and the lines of 0/1 and 2/3 cross each other at other times (six crossings in
+  all).  No two targets share a position or velocity component away from their
+  meeting point;
 * each target is detected with probability ``p_d``; a report holds position and
   velocity (x, y, vx, vy) with Gaussian noise ``noise_scale * (sigma_p, sigma_p,
   sigma_v, sigma_v)``, and an IFF attribute (1 friend, 0 foe) reported wrong with
@@ -34,8 +36,8 @@ import numpy as np
 __all__ = ["Xue1999", "Scan", "OURS", "TARGET_STARTS", "TARGET_VELOCITIES", "TARGET_IFF"]
 
 #: Start positions (m) and velocities (m/s) of the four targets (ours).
-TARGET_STARTS = ((0.0, 4000.0), (0.0, 6000.0), (2000.0, 0.0), (8000.0, 0.0))
-TARGET_VELOCITIES = ((50.0, 10.0), (50.0, -10.0), (20.0, 50.0), (-20.0, 50.0))
+TARGET_STARTS = ((0.0, 4000.0), (1000.0, 6500.0), (2000.0, 0.0), (8750.0, 750.0))
+TARGET_VELOCITIES = ((50.0, 10.0), (40.0, -15.0), (20.0, 50.0), (-25.0, 45.0))
 #: IFF of each target: 1 friend, 0 foe (ours): the shallow pair shares it.
 TARGET_IFF = (0, 0, 1, 0)
 
