@@ -14,6 +14,9 @@ from . import xue1999 as repro
 __all__ = ["make_figures"]
 
 _COLOURS = ("tab:blue", "tab:orange", "tab:green", "tab:red")
+#: One colour per method in every figure.
+_METHOD_COLOURS = {"did": "tab:blue", "did-literal": "tab:orange", "did-origin": "tab:green",
+                   "did-q0": "tab:red", "gnn": "tab:purple", "nn": "tab:brown"}
 
 
 def make_figures(summary: Mapping[str, Any], out, options: Mapping[str, Any]) -> list[str]:
@@ -77,8 +80,8 @@ def _scene(plt, summary, out, o) -> str | None:
     fig.suptitle(f"one run (seed {o['example_seed']}), noise scale {sc.noise_scale:g}, "
                  f"clutter mean {sc.clutter_mean:g} per scan (ours); track colour = the "
                  "target whose report started it, black = started by clutter", fontsize=9)
-    fig.tight_layout()
-    fig.savefig(out / "fig_scene.png", dpi=110)
+    fig.tight_layout(rect=(0, 0, 1, 0.93))
+    fig.savefig(out / "fig_scene.png", dpi=110, bbox_inches="tight")
     plt.close(fig)
     return "fig_scene.png"
 
@@ -95,7 +98,7 @@ def _per_scan(plt, summary, out, o) -> str | None:
         if not rows:
             continue
         k, v, se = map(np.array, zip(*rows))
-        line, = ax.plot(k, v, "-", lw=1.2, label=repro.LABELS[m])
+        line, = ax.plot(k, v, "-", lw=1.2, label=repro.LABELS[m], color=_METHOD_COLOURS.get(m))
         ax.fill_between(k, v - 1.96 * se, v + 1.96 * se, color=line.get_color(), alpha=0.2)
     for k in (20, 30):
         ax.axvline(k, color="0.5", ls=":", lw=0.8)
@@ -127,7 +130,7 @@ def _sweep(plt, summary, out, o) -> str | None:
                 continue
             f, v, _, se = zip(*pts)
             ax.errorbar(f, v, yerr=1.96 * np.array([s or 0.0 for s in se]), marker="o",
-                        ms=3, capsize=2, label=repro.LABELS[m])
+                        ms=3, capsize=2, label=repro.LABELS[m], color=_METHOD_COLOURS.get(m))
         ax.set_title(f"clutter mean {c:g} per scan", fontsize=9)
         ax.set_xlabel("noise scale (x sigma_p, sigma_v)")
         ax.grid(alpha=0.3)
@@ -135,7 +138,7 @@ def _sweep(plt, summary, out, o) -> str | None:
     axes[0].legend(fontsize=7)
     runs = max(v[1] for v in tab.values())
     fig.suptitle(f"where each method breaks ({runs} runs per point, 95 % CI)", fontsize=9)
-    fig.tight_layout()
-    fig.savefig(out / "fig_sweep.png", dpi=110)
+    fig.tight_layout(rect=(0, 0, 1, 0.93))
+    fig.savefig(out / "fig_sweep.png", dpi=110, bbox_inches="tight")
     plt.close(fig)
     return "fig_sweep.png"
