@@ -18,9 +18,8 @@ from assocopt.tracking.decide.did import (AMBIGUOUS, NEW, UNIQUE, DIDParams, did
                                           stage1_case, stage2, strength_matrix)
 from assocopt.tracking.decide.nearest import gnn_assign, nearest_neighbour
 from assocopt.tracking.scenarios.xue1999 import Xue1999
-from assocopt.tracking.scenarios.xue1999_tracker import (METHODS, TrackerParams,
-                                                         association_costs, run_metrics,
-                                                         run_tracker)
+from assocopt.tracking.scenarios.xue1999_tracker import (METHODS, association_costs,
+                                                         run_metrics, run_tracker)
 
 ROOT = Path(__file__).resolve().parents[1]
 

@@ -19,7 +19,6 @@ parameters are ours and recorded in ``summary.json``; the page is
 from __future__ import annotations
 
 import json
-import math
 import os
 import time
 from dataclasses import fields
