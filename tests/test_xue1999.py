@@ -164,6 +164,12 @@ def test_stage1_case_3_goes_to_stage_2():
     res = did_decide(initial_states(two, P), P)
     q = initial_states(two, P)[0].sum(axis=0)
     assert res.stage.tolist() == [2] and res.choice[0] == int(np.argmax(q))
+    # columns that already agree are not moved by stage 2
+    assert res.iterations.tolist() == [0]
+    assert np.array_equal(res.states, initial_states(two, P))
+    res_m = did_decide(initial_states(mixed, P), P)
+    assert res_m.iterations[0] > 0 and np.array_equal(res_m.states[0, :, 1],
+                                                      initial_states(mixed, P)[0, :, 1])
 
 
 def test_stage2_flips_the_minority_factor_and_respects_bounds():
