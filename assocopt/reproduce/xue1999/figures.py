@@ -8,8 +8,10 @@ from typing import Any, Mapping
 
 import numpy as np
 
-from ..tracking.scenarios.xue1999_tracker import run_tracker
-from . import xue1999 as repro
+from ...tracking.scenarios.xue1999_tracker import METHODS, run_tracker
+from . import experiment as exp
+from .experiment import LABELS
+from .report import lookup
 
 __all__ = ["make_figures"]
 
@@ -37,11 +39,11 @@ def make_figures(summary: Mapping[str, Any], out, options: Mapping[str, Any]) ->
 
 
 def _scene(plt, summary, out, o) -> str | None:
-    sc = repro._scenario(o)
-    tp = repro._tracker(o)
+    sc = exp._scenario(o)
+    tp = exp._tracker(o)
     scans = sc.simulate(np.random.default_rng(int(o["example_seed"])))
     X = sc.truth()
-    methods = [m for m in ("did", "did-q0", "gnn") if m in repro.METHODS]
+    methods = [m for m in ("did", "did-q0", "gnn") if m in METHODS]
     fig, axes = plt.subplots(1, 1 + len(methods), figsize=(4.2 * (1 + len(methods)), 4.7),
                              sharex=True, sharey=True)
     ax = axes[0]
@@ -70,7 +72,7 @@ def _scene(plt, summary, out, o) -> str | None:
             own = log.owner[tid]
             ax.plot(p[:, 0], p[:, 1], "-", lw=0.9,
                     color=_COLOURS[own % 4] if own >= 0 else "k")
-        ax.set_title(f"confirmed tracks: {repro.LABELS[m]}\n(like the paper's Fig. 3)",
+        ax.set_title(f"confirmed tracks: {LABELS[m]}\n(like the paper's Fig. 3)",
                      fontsize=9)
     for ax in axes:
         ax.set_xlabel("x (km)")
@@ -92,13 +94,13 @@ def _per_scan(plt, summary, out, o) -> str | None:
     if not recs:
         return None
     fig, ax = plt.subplots(figsize=(7, 4.2))
-    for m in repro.METHODS:
+    for m in METHODS:
         rows = sorted((int(r["metric"][5:]), r["value"], r["stderr"] or 0.0)
                       for r in recs if r["method"] == m)
         if not rows:
             continue
         k, v, se = map(np.array, zip(*rows))
-        line, = ax.plot(k, v, "-", lw=1.2, label=repro.LABELS[m], color=_METHOD_COLOURS.get(m))
+        line, = ax.plot(k, v, "-", lw=1.2, label=LABELS[m], color=_METHOD_COLOURS.get(m))
         ax.fill_between(k, v - 1.96 * se, v + 1.96 * se, color=line.get_color(), alpha=0.2)
     for k in (20, 30):
         ax.axvline(k, color="0.5", ls=":", lw=0.8)
@@ -117,20 +119,20 @@ def _per_scan(plt, summary, out, o) -> str | None:
 
 
 def _sweep(plt, summary, out, o) -> str | None:
-    tab = repro.lookup(summary["records"], "sweep", "correct_rate")
+    tab = lookup(summary["records"], "sweep", "correct_rate")
     if not tab:
         return None
     clutter = sorted({k[2] for k in tab})
     fig, axes = plt.subplots(1, len(clutter), figsize=(4 * len(clutter), 3.8), sharey=True)
     axes = np.atleast_1d(axes)
     for ax, c in zip(axes, clutter):
-        for m in repro.METHODS:
+        for m in METHODS:
             pts = sorted((k[1], *v) for k, v in tab.items() if k[0] == m and k[2] == c)
             if not pts:
                 continue
             f, v, _, se = zip(*pts)
             ax.errorbar(f, v, yerr=1.96 * np.array([s or 0.0 for s in se]), marker="o",
-                        ms=3, capsize=2, label=repro.LABELS[m], color=_METHOD_COLOURS.get(m))
+                        ms=3, capsize=2, label=LABELS[m], color=_METHOD_COLOURS.get(m))
         ax.set_title(f"clutter mean {c:g} per scan", fontsize=9)
         ax.set_xlabel("noise scale (x sigma_p, sigma_v)")
         ax.grid(alpha=0.3)
