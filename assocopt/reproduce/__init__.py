@@ -19,7 +19,7 @@ from pathlib import Path
 from typing import Any, Callable, Mapping
 
 from ..errors import AssocoptError
-from . import lu2013, zhang2009
+from . import lu2013, xue1999, zhang2009
 
 __all__ = ["PAPERS", "Paper", "list_papers", "reproduce", "run"]
 
@@ -46,6 +46,10 @@ PAPERS: dict[str, Paper] = {
                        "Zhang et al. 2009, group member matching with position + attribute "
                        "beliefs: Figs. 1-5, Table 1",
                        1000, zhang2009.run, "docs/papers/zhang2009.md"),
+    "xue1999": Paper("xue1999", "003",
+                     "Xue et al. 1999, distributed inference decision (DID) against GNN and "
+                     "nearest neighbour on four crossing targets",
+                     200, xue1999.run, "docs/papers/xue1999.md"),
 }
 
 

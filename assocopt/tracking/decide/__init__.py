@@ -2,7 +2,10 @@
 
 * :mod:`.truncation` -- paper 000's observation-sequence truncation ("MD-ND");
 * :mod:`.md2da` -- paper 000's 2-D assignment baseline ("MD-2DA") as an
-  optimisation model solved by any back end.
+  optimisation model solved by any back end;
+* :mod:`.did` -- paper 003's distributed inference decision (DID), both stages;
+* :mod:`.nearest` -- report-to-track GNN (a 2-D assignment through ``solve``) and
+  nearest neighbour.
 """
 
 from .md2da import MD2DAResult, gate_threshold, md_2da, md_2da_problem

@@ -1,0 +1,385 @@
+"""Paper 003 (Xue et al. 1999): DID's two stages against a loop-based re-implementation,
+hand-built stage-1 cases, the GNN / NN counterparts, the crossing-targets scenario and
+tracker, and the reproduction's summary and page."""
+
+from __future__ import annotations
+
+import json
+import math
+import re
+from pathlib import Path
+
+import numpy as np
+import pytest
+from hypothesis import given, settings, strategies as st
+
+from assocopt.tracking.decide.did import (AMBIGUOUS, NEW, UNIQUE, DIDParams, did_decide,
+                                          dominance, initial_states, relative_errors,
+                                          stage1_case, stage2, strength_matrix)
+from assocopt.tracking.decide.nearest import gnn_assign, nearest_neighbour
+from assocopt.tracking.scenarios.xue1999 import Xue1999
+from assocopt.tracking.scenarios.xue1999_tracker import (METHODS, association_costs,
+                                                         run_metrics, run_tracker)
+
+ROOT = Path(__file__).resolve().parents[1]
+
+
+# ------------------------------------------------ loop-based re-implementation
+def ref_did(a0, A, *, scale=None, floor=None, categorical=(), M=1.0, Mp=6.0, B=0.2,
+            max_iter=50, select="movable", score="final"):
+    """One report, written from the paper's steps with plain loops (no numpy in bulk)."""
+    m, n = len(A), len(A[0])
+    s_on = [[0.0] * n for _ in range(m)]
+    for i in range(m):
+        for j in range(n):
+            diff = abs(a0[i] - A[i][j])
+            if i in categorical:
+                delta = 0.0 if diff == 0 else math.inf
+            elif scale is not None:
+                delta = diff / scale[i]
+            else:
+                delta = diff / max(abs(A[i][j]), floor[i])
+            eta = delta / M
+            s_off = 1.0 if eta >= Mp else eta / Mp
+            s_on[i][j] = 1.0 - s_off
+    Bm = [[0.0 if i == l else B for l in range(m)] for i in range(m)]
+    on = lambda s: s >= 1.0 - s
+    cols_on = [all(on(s_on[i][j]) for i in range(m)) for j in range(n)]
+    cols_off = [all(not on(s_on[i][j]) for i in range(m)) for j in range(n)]
+    if all(cols_off):
+        return {"choice": -1, "stage": 1, "converged": True, "states": s_on}
+    if sum(cols_on) == 1 and all(a or b for a, b in zip(cols_on, cols_off)):
+        return {"choice": cols_on.index(True), "stage": 1, "converged": True, "states": s_on}
+    converged = True
+    initial = [row[:] for row in s_on]
+    assoc = {}
+    for j in range(n):
+        if cols_off[j]:
+            continue
+        col = [s_on[i][j] for i in range(m)]
+        for _ in range(max_iter):
+            states = [on(s) for s in col]
+            if all(states) or not any(states):
+                break
+            ys = [sum(Bm[i][l] * (col[l] - (1.0 - col[l])) for l in range(m) if l != i)
+                  for i in range(m)]
+            cand = [i for i in range(m) if select == "literal" or
+                    (ys[i] > 0 and col[i] < 1.0) or (ys[i] < 0 and col[i] > 0.0)]
+            if not cand:
+                break
+            istar = min(cand, key=lambda i: (abs(col[i] - 0.5), i))
+            new = min(1.0, max(0.0, col[istar] + ys[istar]))
+            if new == col[istar]:
+                break
+            col[istar] = new
+        states = [on(s) for s in col]
+        settled = all(states) or not any(states)
+        converged &= settled
+        for i in range(m):
+            s_on[i][j] = col[i]
+        if all(states):
+            src = col if score == "final" else [initial[i][j] for i in range(m)]
+            assoc[j] = sum(src)
+    if not assoc:
+        return {"choice": -1, "stage": 2, "converged": converged, "states": s_on}
+    best = max(assoc.values())
+    return {"choice": min(j for j, q in assoc.items() if q == best), "stage": 2,
+            "converged": converged, "states": s_on}
+
+
+def _random_inputs(rng, R, m, n):
+    A = rng.normal(0, 1, (m, n))
+    reports = A[:, rng.integers(0, n, R)].T + rng.normal(0, 1.5, (R, m))
+    cat = rng.random(m) < 0.25
+    A[cat] = rng.integers(0, 2, (cat.sum(), n))
+    reports[:, cat] = rng.integers(0, 2, (R, cat.sum()))
+    return reports, A, cat
+
+
+@pytest.mark.parametrize("select", ["movable", "literal"])
+@pytest.mark.parametrize("score", ["final", "initial"])
+@pytest.mark.parametrize("error", ["scale", "origin"])
+def test_did_matches_loop_reimplementation_on_random_inputs(select, score, error):
+    rng = np.random.default_rng(abs(hash((select, score, error))) % 2 ** 32)
+    n_stage2 = 0
+    for _ in range(40):
+        R, m, n = rng.integers(1, 5), rng.integers(2, 7), rng.integers(1, 6)
+        reports, A, cat = _random_inputs(rng, R, m, n)
+        scale = rng.uniform(0.2, 2.0, m)
+        floor = rng.uniform(0.05, 0.5, m)
+        p = DIDParams(M=float(rng.uniform(0.3, 2)), M_prime=float(rng.uniform(1, 8)),
+                      B=float(rng.uniform(0, 1)), max_iter=int(rng.integers(0, 30)),
+                      select=select, score=score)
+        kw = {"scale": scale} if error == "scale" else {"floor": floor}
+        delta = relative_errors(reports, A, error=error, categorical=cat, **kw)
+        res = did_decide(initial_states(delta, p), p)
+        for r in range(R):
+            ref = ref_did(reports[r], A.tolist(), categorical=set(np.flatnonzero(cat)),
+                          M=p.M, Mp=p.M_prime, B=p.B, max_iter=p.max_iter, select=select,
+                          score=score, **({"scale": scale} if error == "scale" else
+                                          {"floor": floor}))
+            assert res.choice[r] == ref["choice"]
+            assert res.stage[r] == ref["stage"]
+            assert bool(res.converged[r]) == ref["converged"]
+            assert np.allclose(res.states[r], ref["states"], atol=1e-12)
+            n_stage2 += ref["stage"] == 2
+    assert n_stage2 > 10                  # the comparison exercised stage 2
+
+
+# ------------------------------------------------------------ stage 1 by hand
+P = DIDParams(M=1.0, M_prime=6.0, B=0.2)
+
+
+def test_stage1_normalisation_reads_eta():
+    s = initial_states(np.array([0.0, 1.5, 3.0, 5.9, 6.0, 60.0, np.inf]), P)
+    assert np.allclose(s, [1.0, 0.75, 0.5, 1 - 5.9 / 6, 0.0, 0.0, 0.0])
+    assert dominance(s).tolist() == [True, True, True, False, False, False, False]
+    s2 = initial_states(np.array([3.0]), DIDParams(M=0.5, M_prime=12.0))
+    assert np.allclose(s2, 0.5)                  # eta = 6 = M'/2: on (s_on >= s_off)
+
+
+def test_stage1_case_1_no_factor_on_is_a_new_target():
+    delta = np.full((1, 3, 2), 4.0)              # eta = 4 > M'/2 everywhere
+    res = did_decide(initial_states(delta, P), P)
+    assert res.stage1.tolist() == [NEW] and res.choice.tolist() == [-1]
+    assert res.stage.tolist() == [1] and res.iterations.tolist() == [0]
+
+
+def test_stage1_case_2_one_column_all_on_others_all_off():
+    delta = np.array([[[0.5, 5.0, 4.0], [1.0, 4.0, 3.5], [0.0, np.inf, 9.0]]])
+    S = initial_states(delta, P)
+    case, k = stage1_case(S)
+    assert case.tolist() == [UNIQUE] and k.tolist() == [0]
+    res = did_decide(S, P)
+    assert res.choice.tolist() == [0] and res.stage.tolist() == [1]
+    assert np.array_equal(res.states, S)          # decided without stage 2: untouched
+    assert res.score[0] == pytest.approx(S[0, :, 0].sum())
+
+
+def test_stage1_case_3_goes_to_stage_2():
+    mixed = np.array([[[0.5, 5.0], [1.0, 4.0], [5.0, 9.0]]])     # column 0 mixes on/off
+    two = np.array([[[0.5, 1.0], [1.0, 0.2], [0.0, 0.0]]])       # two columns all on
+    for delta in (mixed, two):
+        assert stage1_case(initial_states(delta, P))[0].tolist() == [AMBIGUOUS]
+    res = did_decide(initial_states(two, P), P)
+    q = initial_states(two, P)[0].sum(axis=0)
+    assert res.stage.tolist() == [2] and res.choice[0] == int(np.argmax(q))
+    # columns that already agree are not moved by stage 2
+    assert res.iterations.tolist() == [0]
+    assert np.array_equal(res.states, initial_states(two, P))
+    res_m = did_decide(initial_states(mixed, P), P)
+    assert res_m.iterations[0] > 0 and np.array_equal(res_m.states[0, :, 1],
+                                                      initial_states(mixed, P)[0, :, 1])
+
+
+def test_stage2_flips_the_minority_factor_and_respects_bounds():
+    s = np.array([[0.9, 0.9, 0.9, 0.9, 0.0]])     # 4 factors strongly on, IFF mismatch
+    B = strength_matrix(0.2, 5)
+    fin, settled, it = stage2(s, B, 100, "movable")
+    assert settled[0] and dominance(fin).all() and fin.max() <= 1.0
+    lit, settled_l, _ = stage2(s, B, 100, "literal")
+    assert not settled_l[0]                       # literal: saturated factor 0 stalls
+    assert np.all((0 <= lit) & (lit <= 1))
+
+
+def test_strength_matrix_validation():
+    B = strength_matrix(0.3, 3)
+    assert np.array_equal(B, B.T) and not np.diag(B).any()
+    with pytest.raises(ValueError, match="symmetric"):
+        strength_matrix([[0, .1], [.2, 0]], 2)
+    with pytest.raises(ValueError, match="diagonal"):
+        strength_matrix([[.1, .1], [.1, 0]], 2)
+    with pytest.raises(ValueError, match=r"\[0, 1\]"):
+        DIDParams(B=1.5)
+    with pytest.raises(ValueError, match="M_prime"):
+        DIDParams(M_prime=0.5)
+    with pytest.raises(ValueError, match="scale"):
+        relative_errors([[1.0]], [[1.0]], error="scale")
+
+
+def test_origin_reading_depends_on_the_origin_and_scale_reading_does_not():
+    a0, A = np.array([[110.0]]), np.array([[100.0]])
+    shift = 1e4
+    for err, kw in (("scale", {"scale": [10.0]}), ("origin", {"floor": [1.0]})):
+        d1 = relative_errors(a0, A, error=err, **kw)
+        d2 = relative_errors(a0 + shift, A + shift, error=err, **kw)
+        assert (d1 == d2).all() == (err == "scale")
+
+
+@settings(max_examples=60, deadline=None)
+@given(st.integers(0, 2 ** 32 - 1), st.integers(1, 6), st.integers(1, 5),
+       st.floats(0, 1), st.integers(0, 40), st.sampled_from(["movable", "literal"]))
+def test_states_stay_in_unit_interval_and_loop_is_capped(seed, m, n, b, cap, select):
+    rng = np.random.default_rng(seed)
+    S = rng.random((3, m, n))
+    S[rng.random(S.shape) < 0.3] = rng.integers(0, 2)
+    p = DIDParams(B=b, max_iter=cap, select=select)
+    res = did_decide(S, p)
+    assert np.all((res.states >= 0) & (res.states <= 1))   # s_off = 1 - s_on in [0, 1] too
+    assert np.all(res.iterations <= cap * n)
+    assert np.all(res.choice < n) and np.all(res.choice >= -1)
+    for r in range(3):
+        if res.choice[r] >= 0:
+            assert dominance(res.states[r, :, res.choice[r]]).all()
+
+
+# -------------------------------------------------------------- GNN and NN
+@settings(max_examples=40, deadline=None)
+@given(st.integers(0, 2 ** 32 - 1), st.integers(0, 7), st.integers(0, 7))
+def test_gnn_never_gives_a_track_two_reports_and_is_optimal(seed, R, n):
+    import itertools
+    rng = np.random.default_rng(seed)
+    C = rng.uniform(0, 20, (R, n))
+    C[rng.random((R, n)) < 0.3] = np.inf
+    a = gnn_assign(C, 10.0)
+    used = a[a >= 0]
+    assert len(set(used.tolist())) == len(used)
+    assert all(C[r, a[r]] < 10.0 for r in range(R) if a[r] >= 0)
+    if R <= 4 and n <= 4:                         # brute force over all matchings
+        best = math.inf
+        for perm in itertools.product(range(-1, n), repeat=R):
+            t = [j for j in perm if j >= 0]
+            if len(set(t)) == len(t):
+                best = min(best, sum(C[r, j] if j >= 0 else 10.0 for r, j in enumerate(perm)))
+        got = sum(C[r, a[r]] if a[r] >= 0 else 10.0 for r in range(R))
+        assert got == pytest.approx(best)
+
+
+def test_nearest_neighbour_each_track_its_cheapest_report():
+    C = np.array([[1.0, 3.0, 12.0], [2.0, 1.0, np.inf]])
+    assert nearest_neighbour(C, 10.0).tolist() == [0, 1, -1]
+    assert nearest_neighbour(np.zeros((0, 2)), 5.0).tolist() == [-1, -1]
+    with pytest.raises(ValueError, match="NaN"):
+        gnn_assign([[np.nan]], 1.0)
+
+
+def test_association_cost_is_mahalanobis_plus_iff():
+    z = np.array([[1.0, 2.0, 0.0, 0.0]])
+    x = np.zeros((1, 4))
+    S = np.diag([1.0, 4.0, 1.0, 1.0])[None]
+    C = association_costs(z, np.array([1]), x, S, np.array([0]), 3.0)
+    assert C[0, 0] == pytest.approx(1.0 + 1.0 + 3.0)
+
+
+# --------------------------------------------------------- scenario, tracker
+def test_scenario_is_seeded_and_crossings_are_where_stated():
+    sc = Xue1999()
+    a, b = sc.simulate(np.random.default_rng(4)), sc.simulate(np.random.default_rng(4))
+    assert all(np.array_equal(x.reports, y.reports) for x, y in zip(a, b))
+    X = sc.truth()
+    assert np.allclose(X[20, 0, :2], X[20, 1, :2]) and np.allclose(X[30, 2, :2], X[30, 3, :2])
+    none = Xue1999(clutter_mean=0.0, p_d=1.0, noise_scale=1e-9).simulate(np.random.default_rng(0))
+    for k, scan in enumerate(none):
+        assert np.allclose(scan.reports, X[k, scan.source], atol=1e-5)
+    with pytest.raises(ValueError, match="p_d"):
+        Xue1999(p_d=2.0)
+
+
+def test_clutter_and_iff_statistics():
+    sc = Xue1999(clutter_mean=20.0, p_iff=0.3, p_d=1.0)
+    scans = sc.simulate(np.random.default_rng(2))
+    n_clutter = np.mean([(s.source < 0).sum() for s in scans])
+    assert 17 < n_clutter < 23
+    flips = np.concatenate([s.iff[s.source >= 0] != np.array(sc.iff)[s.source[s.source >= 0]]
+                            for s in scans])
+    assert 0.2 < flips.mean() < 0.4
+
+
+@pytest.mark.parametrize("method", sorted(METHODS))
+def test_every_method_tracks_an_easy_scene(method):
+    sc = Xue1999(clutter_mean=0.0, p_d=1.0, noise_scale=0.3, p_iff=0.0)
+    met = run_metrics(run_tracker(sc.simulate(np.random.default_rng(0)), method, sc), sc)
+    assert met["false_tracks"] == 0
+    if method in ("gnn", "nn", "did-q0"):
+        assert met["correct_rate"] > 0.95 and met["held_at_end"] == 1.0
+
+
+def test_gnn_tracker_gives_no_track_two_reports_in_a_scan():
+    sc = Xue1999(clutter_mean=20.0, noise_scale=2.0)
+    log = run_tracker(sc.simulate(np.random.default_rng(7)), "gnn", sc)
+    for source, went, _, new in log.scans:
+        assoc = [t for w in went for t in w if t not in new]
+        assert len(assoc) == len(set(assoc))
+
+
+# ------------------------------------------------------------- reproduction
+SMALL = {"n_scans": 12, "clutter_mean": 5.0}
+
+
+def test_pinned_small_seeded_run():
+    from assocopt.experiments import trial_seed
+    from assocopt.reproduce import xue1999 as repro
+    exp = repro.experiments(1, 0, SMALL, parts=("main",))[0]
+    s = exp.settings[0]
+    res = repro.trial(s, exp.methods, trial_seed(0, s, 0))
+    pinned = {"did": (35 / 44, 0, 1, 0.5, 2 / 97), "did-literal": (8 / 11, 0, 0, 0.5, 1.0),
+              "did-origin": (31 / 44, 0, 0, 1.0, 3 / 97), "did-q0": (1.0, 0, 0, 1.0, 2 / 97),
+              "gnn": (1.0, 0, 0, 1.0, None), "nn": (1.0, 0, 0, 1.0, None)}
+    for m, (rate, swaps, false, held, nonconv) in pinned.items():
+        r = res[m]
+        assert r["correct_rate"] == pytest.approx(rate), m
+        assert (r["swaps"], r["false_tracks"], r["held_at_end"]) == (swaps, false, held), m
+        assert r.get("nonconverged_rate") == (None if nonconv is None else pytest.approx(nonconv))
+
+
+def test_reproduction_writes_summary_figures_and_resumes(tmp_path):
+    from assocopt.reproduce import xue1999 as repro
+    opts = {**SMALL, "noise_grid": (1.0, 2.0), "clutter_grid": (0.0,), "sweep_divisor": 1}
+    printed = []
+    s = repro.run(2, 1, 3, tmp_path, options=opts, echo=printed.append)
+    data = json.loads((tmp_path / "summary.json").read_text())
+    assert data["paper"] == "xue1999" and data["runs"] == 2
+    assert {r["experiment"] for r in data["records"]} == {"main", "sweep"}
+    assert all(r["runs"] == 2 for r in data["records"] if r["metric"] == "correct_rate")
+    assert "did_scale" in data["parameters"]["ours"]["ours"]
+    assert "Base scene" in printed[0] and "Sweep: correct association rate" in printed[0]
+    for f in s["figures"]:
+        assert (tmp_path / f).stat().st_size > 0
+    again = repro.run(2, 1, 3, tmp_path, options=opts, echo=lambda t: None)
+    assert all(v["done"] == 0 for v in again["timing"].values())
+    stable = lambda recs: sorted((json.dumps(r["setting"], sort_keys=True), r["method"],
+                                  r["metric"], r["value"]) for r in recs if not r["volatile"])
+    assert stable(again["records"]) == stable(s["records"])
+
+
+@pytest.mark.slow
+def test_reproduction_same_numbers_with_two_workers(tmp_path):
+    from assocopt.reproduce import xue1999 as repro
+    opts = {**SMALL, "n_scans": 8, "main_methods": ("did", "gnn")}
+    one = repro.run(3, 1, 5, tmp_path / "a", options=opts, parts=("main",), echo=lambda t: None)
+    two = repro.run(3, 2, 5, tmp_path / "b", options=opts, parts=("main",), echo=lambda t: None)
+    pick = lambda s: sorted((r["method"], r["metric"], r["value"]) for r in s["records"]
+                            if not r["volatile"])
+    assert pick(one) == pick(two)
+
+
+def test_reproduction_rejects_unknown_options_and_methods():
+    from assocopt.reproduce import xue1999 as repro
+    with pytest.raises(ValueError, match="unknown xue1999 option"):
+        repro.experiments(2, 0, {"bogus": 1})
+    with pytest.raises(ValueError, match="unknown xue1999 method"):
+        repro.experiments(2, 0, {"sweep_methods": ("jpda",)})
+
+
+# ------------------------------------------------------------- the page
+PAGE = ROOT / "docs" / "papers" / "xue1999.md"
+SUMMARY = ROOT / "docs" / "papers" / "xue1999" / "summary.json"
+
+
+def _block(text: str, name: str) -> str:
+    m = re.search(rf"<!-- {name}:begin -->\n(.*?)\n<!-- {name}:end -->", text, re.DOTALL)
+    assert m, f"the page has no generated block {name!r}"
+    return m.group(1).strip()
+
+
+def test_page_tables_match_the_committed_summary():
+    from assocopt.reproduce import xue1999 as repro
+    summary = json.loads(SUMMARY.read_text())
+    text = PAGE.read_text(encoding="utf-8")
+    assert _block(text, "tables") == repro.render_tables(summary).strip()
+    assert _block(text, "parameters") == repro.render_parameters(summary).strip()
+    assert _block(text, "headline") == repro.render_headline(summary).strip()
+    assert summary["parameters"] == json.loads(json.dumps(repro.parameters()))  # current defaults
+    assert summary["runs"] == 200 and summary["seed"] == 0
+    for f in summary["figures"]:
+        assert (SUMMARY.parent / f).is_file() and f"xue1999/{f}" in text
