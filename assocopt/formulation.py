@@ -10,11 +10,14 @@ this into its own API in bulk as well.
 from __future__ import annotations
 
 from dataclasses import dataclass
+from typing import TYPE_CHECKING
 
 import numpy as np
-import scipy.sparse as sp
 
 from .problem import AssignmentProblem
+
+if TYPE_CHECKING:
+    import scipy.sparse as sp
 
 __all__ = ["LinearModel", "build_model", "RELAXATIONS"]
 

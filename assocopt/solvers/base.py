@@ -23,8 +23,9 @@ from ..problem import AssignmentProblem
 from ..solution import Status
 from .options import Option, check_common, parse_options
 
-__all__ = ["SolveOptions", "RawResult", "Backend", "register", "get_backend",
-           "registered", "available", "check_capabilities", "empty_answer", "Option"]
+__all__ = ["SolveOptions", "RawResult", "Backend", "register", "declare", "get_backend",
+           "registered", "available", "names", "check_capabilities", "empty_answer",
+           "Option"]
 
 
 @dataclass(frozen=True)
@@ -228,6 +229,16 @@ def empty_answer(problem: AssignmentProblem, options: SolveOptions,
 
 
 _REGISTRY: dict[str, type[Backend]] = {}
+#: Back ends known by name whose module has not been imported yet: name -> module.
+#: :func:`get_backend` imports the one module asked for, :func:`registered` all of
+#: them, so ``import assocopt`` and a solve load only the chosen back end's code.
+_DECLARED: dict[str, str] = {}
+
+
+def declare(name: str, module: str) -> None:
+    """Make back end ``name`` known without importing ``module`` (which registers it)."""
+    if name not in _REGISTRY:
+        _DECLARED[name] = module
 
 
 def register(cls: type[Backend]) -> type[Backend]:
@@ -235,23 +246,46 @@ def register(cls: type[Backend]) -> type[Backend]:
     if not cls.name:
         raise ValueError("a back end needs a name")
     _REGISTRY[cls.name] = cls
+    _DECLARED.pop(cls.name, None)
     return cls
 
 
+def _load(name: str) -> None:
+    """Import the module of a declared back end (registering it)."""
+    module = _DECLARED.get(name)
+    if module is not None:
+        importlib.import_module(module)
+        _DECLARED.pop(name, None)     # a module that did not register it: unknown
+
+
+def _load_all() -> None:
+    for name in list(_DECLARED):
+        _load(name)
+
+
+def names() -> list[str]:
+    """Names of all back ends, registered or declared, without importing any."""
+    return sorted(set(_REGISTRY) | set(_DECLARED))
+
+
 def registered() -> dict[str, type[Backend]]:
-    """All registered back ends by name, installed or not."""
+    """All registered back ends by name, installed or not (imports their modules,
+    which import no optional package)."""
+    _load_all()
     return dict(_REGISTRY)
 
 
 def get_backend(name: str) -> type[Backend]:
     """The back end class called ``name``; unknown names list the valid ones."""
+    if name not in _REGISTRY and isinstance(name, str):
+        _load(name)
     try:
         return _REGISTRY[name]
-    except KeyError:
-        valid = ", ".join(sorted(_REGISTRY) + ["auto"])
+    except (KeyError, TypeError):
+        valid = ", ".join(names() + ["auto"])
         raise UnknownSolverError(f"unknown solver {name!r}; valid names: {valid}") from None
 
 
 def available() -> list[str]:
     """Names of the back ends whose packages are installed."""
-    return sorted(n for n, cls in _REGISTRY.items() if cls.is_available())
+    return sorted(n for n, cls in registered().items() if cls.is_available())

@@ -26,7 +26,6 @@ import time
 from dataclasses import dataclass
 
 import numpy as np
-import scipy.sparse as sp
 
 from ..problem import AssignmentProblem
 from ..solution import Status
@@ -220,6 +219,7 @@ def augmented_edges(n1: int, n2: int, rows: np.ndarray, cols: np.ndarray,
 def _sparse_lap(nr: int, nc: int, rows, cols, weights) -> tuple[np.ndarray, np.ndarray]:
     """LAPJVsp on an edge list; weights shifted to be positive (explicit zeros are
     dropped by scipy), which leaves the optimal perfect matching unchanged."""
+    import scipy.sparse as sp
     from scipy.sparse.csgraph import min_weight_full_bipartite_matching
 
     if len(weights) == 0:

@@ -12,15 +12,17 @@ from __future__ import annotations
 import enum
 import math
 import time
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
-import scipy.sparse as sp
 
 from ...problem import AssignmentProblem
 from ..base import SolveOptions, module_installed
 from .ascent import _State
 from .options import OPT_TOL
+
+if TYPE_CHECKING:
+    import scipy.sparse as sp
 
 #: During the ascent, fixing windows up to this size are tried by a short search.
 _PROBE_SEARCH_MAX = 80
