@@ -36,3 +36,8 @@ class SolverCapabilityError(AssocoptError, ValueError):
 
 class ProblemTooLargeError(AssocoptError, ValueError):
     """An exhaustive method (brute force) was asked to solve an instance that is too big."""
+
+
+class MissingDependencyError(AssocoptError, ImportError):
+    """An optional Python package (not a back end's) is missing; the message says
+    what to ``pip install``."""

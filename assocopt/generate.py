@@ -46,7 +46,8 @@ from .solution import Status
 
 __all__ = ["GENERATORS", "DEFAULT_SIZES", "generate", "generate_dense", "generate_sparse",
            "generate_planted", "prove_optimum", "feasibility", "catalogue", "write_index",
-           "default_instances_dir", "INDEX_NAME"]
+           "default_instances_dir", "find_stored_instance", "INDEX_NAME",
+           "PACKAGED_INSTANCES"]
 
 #: Generator names accepted by :func:`generate`.
 GENERATORS = ("dense", "sparse", "planted")
@@ -277,12 +278,35 @@ def feasibility(problem: AssignmentProblem, *, time_limit: float | None = 60.0
 
 
 # ----------------------------------------------------------------------- catalogue
+#: Copies of the stored instances shipped inside the package, so an installed
+#: assocopt has them without the source checkout (tests/test_instances_shipped.py
+#: checks that they equal ``instances/``).
+PACKAGED_INSTANCES = Path(__file__).resolve().parent / "data" / "instances"
+
+
 def default_instances_dir() -> Path:
-    """``./instances`` when it exists, else the project's ``instances/`` folder."""
+    """``./instances`` when it exists, else the source checkout's ``instances/``
+    folder, else the copies installed with the package (``assocopt/data/instances``)."""
     here = Path.cwd() / "instances"
     if here.is_dir():
         return here
-    return Path(__file__).resolve().parent.parent / "instances"
+    project = Path(__file__).resolve().parent.parent / "instances"
+    if (project / INDEX_NAME).is_file():
+        return project
+    return PACKAGED_INSTANCES
+
+
+def find_stored_instance(name: str) -> Path | None:
+    """The stored instance file called ``name`` (``example-sd`` or ``example-sd.json``)
+    in :func:`default_instances_dir`, or None."""
+    if not name or Path(name).name != name:
+        return None
+    folder = default_instances_dir()
+    for candidate in (name, f"{name}.json"):
+        path = folder / candidate
+        if path.suffix == ".json" and path.is_file():
+            return path
+    return None
 
 
 def catalogue(directory: str | os.PathLike[str]) -> list[dict[str, Any]]:

@@ -92,13 +92,19 @@ def _random_sd(rng: np.random.Generator, sizes: tuple[int, ...] | None, integer:
     return AssignmentProblem.sparse(sizes, T, costs)
 
 
-def _hypothesis() -> Any:
-    """hypothesis's strategies module, or an ImportError naming the package."""
+def _hypothesis(helper: str = "draw_costs") -> Any:
+    """``hypothesis.strategies``, or an error that says what to install (an
+    ImportError, and an AssocoptError the CLI shows on one line)."""
     try:
         from hypothesis import strategies as st
-    except ImportError as exc:      # pragma: no cover - hypothesis ships with [dev]
-        raise ImportError("assocopt.testing's strategies need the Python package "
-                          "'hypothesis': pip install hypothesis") from exc
+    except ModuleNotFoundError as exc:
+        if exc.name is None or exc.name.split(".")[0] != "hypothesis":
+            raise
+        from .errors import MissingDependencyError
+        raise MissingDependencyError(
+            f"assocopt.testing.{helper}() is a hypothesis strategy and needs the "
+            "hypothesis package: pip install hypothesis (or pip install "
+            "'assocopt[dev]')") from None
     return st
 
 
@@ -132,7 +138,7 @@ def draw_costs(draw: Any, shape: Any, integer: bool, *, forbid: bool = False,
 def draw_sd(draw: Any, sizes: tuple[int, ...], integer: bool) -> AssignmentProblem:
     """An S-D problem with dummies on ``sizes``: every single-index tuple (so it is
     feasible, at a non-negative cost) and a drawn subset of the multi-index ones."""
-    st = _hypothesis()
+    st = _hypothesis("draw_sd")
     grids = np.meshgrid(*[np.arange(n + 1) for n in sizes], indexing="ij")
     T = np.stack([g.ravel() for g in grids], axis=1)
     n_real = (T > 0).sum(axis=1)
@@ -153,7 +159,7 @@ def problems(kinds: tuple[str, ...] = KINDS, integer: bool | None = None) -> Any
     a seed), so a failing example shrinks to a small one with simple costs.  Sizes
     keep brute force fast.
     """
-    st = _hypothesis()
+    st = _hypothesis("problems")
 
     @st.composite
     def _draw(draw: Any) -> AssignmentProblem:
@@ -257,7 +263,7 @@ def stored_instances(directory: str | os.PathLike[str] | None = None) -> list[Pa
     """The instance files (``*.json``) of ``directory``, sorted.
 
     Default: ``./instances`` when it exists, else the ``instances/`` folder of the
-    assocopt source checkout (empty list for an installed package without it).
+    assocopt source checkout, else the copies installed with the package.
     """
     from .generate import default_instances_dir
 
@@ -275,7 +281,7 @@ def generated_problems(kinds: Sequence[str] = ("dense", "sparse", "planted"), *,
     ``"planted"`` problems carry their optimum (known by construction), so
     :func:`assert_optimal` checks against it without a reference solve.
     """
-    st = _hypothesis()
+    st = _hypothesis("generated_problems")
 
     from .generate import GENERATORS, generate
 

@@ -114,7 +114,9 @@ def _human(problem: Any, sol: Solution, out: TextIO) -> None:
     ver = f" {sol.solver_version}" if sol.solver_version else ""
     rows.append(("solver", f"{sol.solver}{ver}"))
     t = sol.times
-    detail = ", ".join(f"{k} {t[k]:.3g} s" for k in ("build", "solve") if t.get(k) is not None)
+    detail = ", ".join(f"{k.replace('_', ' ')} {t[k]:.3g} s"
+                       for k in ("build", "solve", "compile", "cache_load")
+                       if t.get(k) is not None)
     total = t.get("total")
     rows.append(("time", (f"{total:.3g} s" if total is not None else "-")
                  + (f" ({detail})" if detail else "")))

@@ -34,7 +34,9 @@ def _build_parser() -> argparse.ArgumentParser:
     ps = sub.add_parser("solve", help="solve an instance file",
                         description="Solve an instance file (assocopt JSON, Grundel, "
                                     "Balas-Saltzman or OR-Library format).")
-    ps.add_argument("file", metavar="FILE", help="instance file")
+    ps.add_argument("file", metavar="FILE",
+                    help="instance file, or the name of a stored instance (see "
+                         "'assocopt instances')")
     ps.add_argument("--solver", default=None,
                     help="back end name (see 'assocopt solvers'); default: auto")
     ps.add_argument("--model", metavar="MODEL", default=None,

@@ -18,18 +18,66 @@ from .common import (EXIT_BAD_INPUT, EXIT_INTERNAL, EXIT_LIMIT, EXIT_OK, _error,
                      _matches, _num, _one_line, _os_message, _solve_record, _table, exit_code)
 
 
-def _compile_note(problem: Any, solver: str, relax: str | None, err: TextIO) -> None:
-    """One line on stderr before the numba kernels are compiled (first run only)."""
+#: ``assocopt solve`` without ``--solver`` solves one problem per process: an S-D
+#: problem this small is first enumerated exhaustively (``bruteforce``, numpy only,
+#: at most :data:`ONE_SHOT_NODES` search nodes: 25-65 ms measured), which is quicker
+#: than importing numba and loading ``bnb``'s kernels (0.3-0.5 s).  Larger problems,
+#: or a search that runs out of nodes, go to ``auto``'s choice as before.
+ONE_SHOT_CANDIDATES = 64
+ONE_SHOT_NODES = 20_000
+
+
+def _instance_path(text: str) -> str:
+    """``text``, or the stored instance of that name when no such file exists
+    (``assocopt solve example-sd`` works from any folder, installed or not)."""
+    if Path(text).exists():
+        return text
+    from ..generate import find_stored_instance
+
+    stored = find_stored_instance(text)
+    return str(stored) if stored is not None else text
+
+
+def _one_shot(problem: Any, relax: str | None) -> Any:
+    """The exact answer by enumeration for a tiny S-D problem, or None (see above)."""
+    from ..api import solve
+    from ..solution import Status
+
+    if relax is not None or problem.ndim < 3 or problem.n_candidates > ONE_SHOT_CANDIDATES:
+        return None
+    sol = solve(problem, "bruteforce", max_nodes=ONE_SHOT_NODES)
+    if sol.status not in (Status.OPTIMAL, Status.INFEASIBLE):
+        return None
+    sol.message = (f"{sol.message} (auto: one small problem, enumerated rather than "
+                   "loading the compiled bnb kernels)")
+    return sol
+
+
+def _compile_note(problem: Any, solver: str, relax: str | None, err: TextIO) -> bool:
+    """Start a line on stderr before ``bnb``'s numba kernels are compiled (first run
+    only); :func:`_compile_done` ends it with the time taken.  True if begun."""
     from ..api import choose_solver
     from ..solvers import get_backend
 
     name = choose_solver(problem, relax) if solver == "auto" else solver
-    if relax is not None or name not in ("bnb", "lagrangian-exact") or \
-            not get_backend("bnb").is_available():
-        return
+    if relax is not None or name != "bnb" or not get_backend("bnb").is_available():
+        return False
     from ..solvers import bnb_kernels
-    if not bnb_kernels.cached():
-        print("assocopt: compiling the numba kernels (first run only, about 15-30 s; "
+    if bnb_kernels.cached():
+        return False
+    print("assocopt: compiling the numba kernels (first run only, about 15-30 s; "
+          "cached afterwards) ...", end="", file=err, flush=True)
+    return True
+
+
+def _compile_done(sol: Any, begun: bool, err: TextIO) -> None:
+    """One line on stderr with the compilation time, when the solve compiled kernels."""
+    took = sol.times.get("compile", 0.0) if sol is not None else 0.0
+    if begun:
+        print(f" done in {took:.1f} s" if took > 0 else " loaded from the cache instead",
+              file=err)
+    elif took > 0:
+        print(f"assocopt: compiled the numba kernels in {took:.1f} s (first run only; "
               "cached afterwards)", file=err)
 
 
@@ -46,16 +94,29 @@ def _cmd_solve(args: argparse.Namespace, out: TextIO, err: TextIO) -> int:
         if args.relax is not None and args.relax != model.relax:
             raise AssocoptError(f"--relax {args.relax} conflicts with model {model.name!r} "
                                 f"(formulation {model.formulation!r})")
-        problem = read_instance(args.file, format=args.format, instance=args.instance)
-        _compile_note(problem, model.solver, model.relax, err)
-        sol = model.solve(problem, time_limit=args.time_limit, mip_gap=args.gap,
-                          threads=args.threads)
+        problem = read_instance(_instance_path(args.file), format=args.format,
+                                instance=args.instance)
+        begun, sol = _compile_note(problem, model.solver, model.relax, err), None
+        try:
+            sol = model.solve(problem, time_limit=args.time_limit, mip_gap=args.gap,
+                              threads=args.threads)
+        finally:
+            _compile_done(sol, begun, err)
     else:
-        problem = read_instance(args.file, format=args.format, instance=args.instance)
-        _compile_note(problem, args.solver or "auto", args.relax, err)
-        sol = solve(problem, args.solver or "auto", relax=args.relax,
-                    time_limit=args.time_limit,
-                    mip_gap=0.0 if args.gap is None else args.gap, threads=args.threads)
+        problem = read_instance(_instance_path(args.file), format=args.format,
+                                instance=args.instance)
+        sol = None
+        if args.solver is None and args.time_limit is None and not args.gap:
+            sol = _one_shot(problem, args.relax)
+        if sol is None:
+            begun = _compile_note(problem, args.solver or "auto", args.relax, err)
+            try:
+                sol = solve(problem, args.solver or "auto", relax=args.relax,
+                            time_limit=args.time_limit,
+                            mip_gap=0.0 if args.gap is None else args.gap,
+                            threads=args.threads)
+            finally:
+                _compile_done(sol, begun, err)
     record = _solve_record(problem, sol)
     if args.out:
         write_solution(sol, args.out, extra={k: record[k] for k in

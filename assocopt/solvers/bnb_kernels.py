@@ -17,6 +17,9 @@ bounds every solution from below: the bound is valid whatever the multipliers, a
 the ascent only makes it tight.
 """
 
+from typing import Any
+
+from .kernels import ensure, spent  # noqa: F401  (compile / cache-load clock)
 from .kernels.driver import (INFEASIBLE, PROVEN, STOPPED, recover3, solve,  # noqa: F401
                              tuple_index)
 from .kernels.hungarian import hungarian, hungarian_warm  # noqa: F401
@@ -25,13 +28,14 @@ from .kernels.relaxation import (evaluate, full_reduced, improve_limit,  # noqa:
 from .kernels.search import BUDGET, COMPLETE, dfs  # noqa: F401
 
 
-def cached() -> bool:
-    """Whether compiled code of the main kernels is on disk (so the first call loads it
-    instead of compiling for 15-30 s).  Reads numba's cache index paths, which are not
-    public API: on any surprise it answers True (no warning rather than a wrong one)."""
+def cached(*kernels: Any) -> bool:
+    """Whether compiled code of ``kernels`` (default: those ``bnb`` calls) is on disk,
+    so the first call loads it instead of compiling for 15-30 s.  Reads numba's cache
+    index paths, which are not public API: on any surprise it answers True (no note
+    rather than a wrong one)."""
     import os
     try:
         return all(os.path.exists(f._cache._cache_file._index_path)
-                   for f in (solve, dfs, prepare))
+                   for f in (kernels or (solve, prepare)))
     except Exception:
         return True

@@ -33,13 +33,17 @@ class _NodeLimit(Exception):
 
 
 def _candidate_masks(problem: AssignmentProblem) -> tuple[list[int], list[list[int]]]:
-    """Bit mask of covered rows per candidate; candidates covering each row."""
-    A = problem.coverage_matrix().tocsc()
-    masks = [sum(1 << int(r) for r in A.indices[A.indptr[k]:A.indptr[k + 1]])
-             for k in range(problem.n_candidates)]
-    Ar = A.tocsr()
-    by_row = [Ar.indices[Ar.indptr[r]:Ar.indptr[r + 1]].tolist()
-              for r in range(problem.n_rows)]
+    """Bit mask of covered rows per candidate; candidates covering each row (in
+    candidate order).  Straight from the tuple array: no scipy.sparse to import."""
+    T = problem.tuples
+    real = T > 0
+    rows = np.where(real, T - 1 + problem.row_offsets[None, :], -1)
+    masks = [sum(1 << r for r in row if r >= 0) for row in rows.tolist()]
+    ks = np.broadcast_to(np.arange(len(T))[:, None], T.shape)[real]
+    rs = rows[real]
+    order = np.lexsort((ks, rs))
+    splits = np.cumsum(np.bincount(rs, minlength=problem.n_rows))[:-1]
+    by_row = [part.tolist() for part in np.split(ks[order], splits)]
     return masks, by_row
 
 

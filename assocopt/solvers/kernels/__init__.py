@@ -1,3 +1,44 @@
 """numba kernels of the ``bnb`` back end and the compiled window search of
 ``lagrangian-exact``; imported only when one of them runs (importing numba costs
-half a second).  :mod:`assocopt.solvers.bnb_kernels` is the one import point."""
+half a second).  :mod:`assocopt.solvers.bnb_kernels` is the one import point.
+
+This package file itself imports no numba: it holds the clock of compilation and
+cache loading (:func:`ensure`, :func:`spent`), which :func:`assocopt.solve` reads
+without loading the kernels.
+"""
+
+from __future__ import annotations
+
+import time
+from typing import Any
+
+__all__ = ["ensure", "spent"]
+
+
+#: Seconds this process spent compiling kernels and loading them from numba's disk
+#: cache (:func:`ensure`); :func:`assocopt.solve` reports the part spent during a
+#: solve as ``times["compile"]`` and ``times["cache_load"]``, apart from build/solve.
+_SPENT = {"compile": 0.0, "cache_load": 0.0}
+
+
+def spent() -> tuple[float, float]:
+    """``(compile, cache_load)`` seconds spent so far in this process."""
+    return _SPENT["compile"], _SPENT["cache_load"]
+
+
+def ensure(kernel: Any, *args: Any) -> None:
+    """Make sure ``kernel`` has machine code for the types of ``args`` (only that
+    specialisation, and the kernels it calls), timing the compilation or the load
+    from the disk cache apart from the call itself."""
+    try:
+        sig = tuple(kernel.typeof_pyval(a) for a in args)
+    except Exception:          # not a numba dispatcher: nothing to prepare
+        return
+    if sig in kernel.overloads:
+        return
+    hits = sum(kernel.stats.cache_hits.values())
+    t0 = time.perf_counter()
+    kernel.compile(sig)
+    dt = time.perf_counter() - t0
+    _SPENT["cache_load" if sum(kernel.stats.cache_hits.values()) > hits else "compile"] += dt
+
