@@ -207,13 +207,85 @@ def test_reduced_cost_bound_is_valid_for_any_dual(p, seed):
 def test_cli_says_when_it_compiles(monkeypatch, capsys):
     from pathlib import Path
     from assocopt.cli import main
-    example = Path(__file__).resolve().parents[1] / "instances" / "example-3d.json"
+    # sd-bearing-3s is too large for the one-shot enumeration: auto runs bnb
+    example = Path(__file__).resolve().parents[1] / "instances" / "sd-bearing-3s.json"
     monkeypatch.setattr(kern, "cached", lambda: False)
     assert main(["solve", str(example)]) == 0
-    assert "compiling the numba kernels" in capsys.readouterr().err
+    err = capsys.readouterr().err
+    assert err.startswith("assocopt: compiling the numba kernels") and err.count("\n") == 1
     monkeypatch.setattr(kern, "cached", lambda: True)
     assert main(["solve", str(example)]) == 0
     assert capsys.readouterr().err == ""
     monkeypatch.setattr(kern, "cached", lambda: False)
     assert main(["solve", str(example), "--solver", "highs"]) == 0
     assert capsys.readouterr().err == ""
+
+
+def test_cli_prints_how_long_compilation_took(monkeypatch, capsys):
+    """A solve that compiled kernels (times["compile"] > 0) ends with one stderr line
+    giving the time, whether or not the cache check announced it beforehand."""
+    from pathlib import Path
+
+    import assocopt.api
+    from assocopt.cli import main
+    example = Path(__file__).resolve().parents[1] / "instances" / "sd-bearing-3s.json"
+    real = assocopt.api.solve
+
+    def compiled(*args, **kwargs):
+        sol = real(*args, **kwargs)
+        sol.times["compile"] = 12.34
+        return sol
+    monkeypatch.setattr(assocopt.api, "solve", compiled)
+    monkeypatch.setattr(kern, "cached", lambda: True)
+    assert main(["solve", str(example)]) == 0
+    assert capsys.readouterr().err == ("assocopt: compiled the numba kernels in 12.3 s "
+                                       "(first run only; cached afterwards)\n")
+    monkeypatch.setattr(kern, "cached", lambda: False)
+    assert main(["solve", str(example)]) == 0
+    assert capsys.readouterr().err == ("assocopt: compiling the numba kernels (first run "
+                                       "only, about 15-30 s; cached afterwards) ... done in "
+                                       "12.3 s\n")
+
+
+def test_compile_and_cache_load_are_reported_apart(monkeypatch):
+    """Kernel compilation / cache loading during a solve appears as times["compile"] /
+    times["cache_load"] (and info fields), and is not counted in build or solve."""
+    from assocopt.solvers import kernels
+
+    p = AssignmentProblem.dense(np.random.default_rng(3).random((4, 4, 4)))
+    solve(p, "bnb")                              # kernels in memory now
+    warm = solve(p, "bnb")
+    assert "compile" not in warm.times and "compile_time" not in warm.info
+    # pretend the kernels are not in memory: ensure() compiles / loads again
+    calls = []
+
+    def slow_ensure(kernel, *args):
+        calls.append(kernel)
+        kernels._SPENT["cache_load"] += 0.5      # as if loading took half a second
+    monkeypatch.setattr(kern, "ensure", slow_ensure)
+    sol = solve(p, "bnb")
+    assert {kern.prepare, kern.solve} <= set(calls)
+    assert sol.times["cache_load"] == pytest.approx(0.5 * len(calls))
+    assert sol.info["cache_load_time"] == sol.times["cache_load"]
+    assert sol.times["compile"] == 0.0
+    assert sol.times["build"] < 0.5 and sol.times["solve"] < 0.5
+
+
+def test_ensure_times_a_fresh_specialisation():
+    """ensure() adds exactly one specialisation and books its time as compile or
+    cache load; a second call for the same types does nothing."""
+    from numba import njit
+
+    from assocopt.solvers import kernels
+
+    @njit(cache=False)
+    def twice(x):
+        return 2 * x
+    before = sum(kernels.spent())
+    kern.ensure(twice, 3.0)
+    assert len(twice.overloads) == 1
+    mid = sum(kernels.spent())
+    assert mid > before                          # compiled (no cache): counted
+    kern.ensure(twice, 4.0)
+    assert sum(kernels.spent()) == mid and len(twice.overloads) == 1
+    assert twice(4.0) == 8.0 and len(twice.overloads) == 1

@@ -74,7 +74,7 @@ def _compile_done(sol: Any, begun: bool, err: TextIO) -> None:
     """One line on stderr with the compilation time, when the solve compiled kernels."""
     took = sol.times.get("compile", 0.0) if sol is not None else 0.0
     if begun:
-        print(f" done in {took:.1f} s" if took > 0 else " loaded from the cache instead",
+        print(f" done in {took:.1f} s" if took > 0 else " not needed (already compiled)",
               file=err)
     elif took > 0:
         print(f"assocopt: compiled the numba kernels in {took:.1f} s (first run only; "

@@ -1,0 +1,158 @@
+"""Fast start: what ``import assocopt``, the registry and a CLI solve load, and the
+start-up benchmark's docs page.  No timing is asserted here (the benchmark measures
+it, benchmarks/startup.py); these tests check which modules get imported, in a fresh
+interpreter each."""
+
+from __future__ import annotations
+
+import importlib.util
+import json
+import os
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+
+ROOT = Path(__file__).resolve().parents[1]
+HEAVY = ("scipy.sparse", "scipy.optimize", "numba", "highspy", "ortools", "cvxpy",
+         "matplotlib")
+
+
+def _loaded(code: str, cwd: Path = ROOT) -> set[str]:
+    """Module names loaded after running ``code`` in a fresh interpreter."""
+    env = dict(os.environ, PYTHONPATH=str(ROOT))
+    script = code + "\nimport sys, json\nprint(json.dumps(sorted(sys.modules)))"
+    out = subprocess.run([sys.executable, "-c", script], cwd=cwd, env=env, check=True,
+                         capture_output=True, text=True).stdout
+    return set(json.loads(out.splitlines()[-1]))
+
+
+def _heavy(mods: set[str]) -> list[str]:
+    return sorted(m for m in HEAVY if m in mods)
+
+
+def test_import_assocopt_loads_no_heavy_package():
+    mods = _loaded("import assocopt")
+    assert _heavy(mods) == []
+    assert not [m for m in mods if m.startswith("assocopt.solvers.")
+                and m not in ("assocopt.solvers.base", "assocopt.solvers.kernels")]
+
+
+def test_listing_back_ends_imports_none_of_their_packages():
+    mods = _loaded("import assocopt.solvers as s\nnames = sorted(s.registered())\n"
+                   "s.available()\nassert 'highs' in names and 'bnb' in names")
+    assert _heavy(mods) == []
+
+
+def test_cli_parser_and_solvers_listing_stay_light(tmp_path):
+    mods = _loaded("from assocopt.cli import main\nassert main(['solvers']) == 0\n"
+                   "assert main(['--help']) == 0", cwd=tmp_path)
+    assert _heavy(mods) == []
+
+
+def test_2d_solve_loads_only_its_back_end():
+    mods = _loaded("from assocopt.cli import main\n"
+                   "assert main(['solve', 'instances/example-2d-miss.json']) == 0")
+    assert "scipy.optimize" in mods          # linear_sum_assignment
+    assert set(_heavy(mods)) <= {"scipy.optimize", "scipy.sparse"}  # scipy's own imports
+    solvers = {m for m in mods if m.startswith("assocopt.solvers.")}
+    assert solvers == {"assocopt.solvers.base", "assocopt.solvers.kernels",
+                       "assocopt.solvers.scipy_lsa"}
+
+
+@pytest.mark.skipif(importlib.util.find_spec("numba") is None, reason="needs numba")
+def test_bnb_solve_loads_numba_but_not_the_other_back_ends():
+    mods = _loaded("from assocopt.cli import main\n"
+                   "assert main(['solve', 'instances/sd-bearing-3s.json']) == 0")
+    assert "numba" in mods and "assocopt.solvers.bnb_kernels" in mods
+    for other in ("highspy", "ortools", "cvxpy", "assocopt.solvers.highs",
+                  "assocopt.solvers.lagrangian"):
+        assert other not in mods, other
+
+
+def test_tiny_sd_solve_from_the_cli_loads_no_compiled_kernels(capsys):
+    """One small S-D problem per process: enumerated exactly, numba not imported."""
+    mods = _loaded("from assocopt.cli import main\n"
+                   "assert main(['solve', 'instances/example-sd.json']) == 0")
+    assert _heavy(mods) == []
+    assert "assocopt.solvers.bruteforce" in mods
+
+
+def test_one_shot_answer_equals_auto_in_the_library(capsys):
+    """The CLI's enumeration of a tiny problem gives the same optimum as auto."""
+    from assocopt import solve
+    from assocopt.cli import main
+    from assocopt.io import read_instance
+
+    for name in ("example-sd", "example-3d"):
+        path = ROOT / "instances" / f"{name}.json"
+        assert main(["solve", str(path), "--json"]) == 0
+        rec = json.loads(capsys.readouterr().out)
+        ref = solve(read_instance(path))
+        assert rec["solver"] == "bruteforce" and rec["status"] == "optimal"
+        assert rec["objective"] == pytest.approx(ref.objective, abs=1e-9)
+        assert "enumerated" in rec["message"]
+
+
+def test_one_shot_falls_back_when_enumeration_is_too_long(capsys, monkeypatch):
+    """A search that runs out of nodes goes to auto's back end as before."""
+    import assocopt.cli.solve_cmds as sc
+    from assocopt.cli import main
+
+    monkeypatch.setattr(sc, "ONE_SHOT_NODES", 3)
+    assert main(["solve", str(ROOT / "instances" / "example-sd.json"), "--json"]) == 0
+    rec = json.loads(capsys.readouterr().out)
+    assert rec["solver"] != "bruteforce" and rec["status"] == "optimal"
+    # --solver always means that back end
+    monkeypatch.undo()
+    assert main(["solve", str(ROOT / "instances" / "example-sd.json"), "--json",
+                 "--solver", "highs"]) == 0
+    assert json.loads(capsys.readouterr().out)["solver"] == "highs"
+
+
+def test_solvers_are_reachable_as_attributes():
+    """``assocopt.solvers.bnb`` and friends still work as attribute paths."""
+    import assocopt.solvers as s
+    assert s.bnb.BranchBoundBackend.name == "bnb"
+    assert s.get_backend("scipy-lsa").__module__ == "assocopt.solvers.scipy_lsa"
+    with pytest.raises(AttributeError):
+        s.no_such_module  # noqa: B018
+    from assocopt import UnknownSolverError
+    with pytest.raises(UnknownSolverError, match="valid names: bnb, bruteforce"):
+        s.get_backend("nope")
+
+
+# ------------------------------------------------------------------ the docs page
+def _bench():
+    spec = importlib.util.spec_from_file_location("startup_bench",
+                                                  ROOT / "benchmarks" / "startup.py")
+    mod = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(mod)
+    return mod
+
+
+def test_startup_page_is_rendered_from_the_committed_measurements():
+    """docs/benchmarks-startup.md is exactly what benchmarks/startup.py renders from
+    the json the same run wrote.  Refresh both: python benchmarks/startup.py"""
+    bench = _bench()
+    data = json.loads(bench.DATA.read_text())
+    assert bench.PAGE.read_text() == bench.render(data)
+
+
+def test_startup_measurements_are_consistent():
+    """Each ratio is the best time over the baseline's best time; best is the minimum
+    of the rounds; met says whether the ratio is within the target."""
+    bench = _bench()
+    data = json.loads(bench.DATA.read_text())
+    rows = {r["key"]: r for r in data["rows"]}
+    assert set(rows) == {key for key, *_ in bench.COMMANDS}
+    base = rows["baseline"]["best_s"]
+    for r in rows.values():
+        assert len(r["all_s"]) == data["rounds"]
+        assert r["best_s"] == pytest.approx(min(r["all_s"]), abs=1e-4)
+        assert r["ratio"] == pytest.approx(r["best_s"] / base, abs=2e-3)
+        if r["target"] is not None:
+            assert r["met"] == (r["ratio"] <= r["target"])
+    targets = {key: target for key, _, _, target in bench.COMMANDS}
+    assert {k: r["target"] for k, r in rows.items()} == targets
