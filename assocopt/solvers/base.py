@@ -12,6 +12,7 @@ from __future__ import annotations
 import functools
 import importlib.metadata
 import importlib.util
+import sys
 from dataclasses import dataclass, field
 from typing import Any, ClassVar
 
@@ -183,11 +184,16 @@ class Backend:
     @classmethod
     def version(cls) -> str:
         """Version of the method: assocopt's for its own methods, else that of the
-        package doing the work ("" when not installed)."""
+        package doing the work ("" when not installed): the imported module's
+        ``__version__`` when the module is the distribution (no metadata scan: the
+        first costs 10-15 ms), else the installed metadata."""
         if cls.own_method or cls.distribution is None:
             from .. import __version__
             return __version__
-        return _distribution_version(cls.distribution)
+        dist = cls.distribution
+        mod = sys.modules.get(dist) if (cls.module or dist) == dist else None
+        found = getattr(mod, "__version__", None)
+        return found if isinstance(found, str) and found else _distribution_version(dist)
 
     @classmethod
     def require(cls) -> None:
