@@ -42,6 +42,8 @@ COMMANDS: list[tuple[str, str, list[str], float | None]] = [
      ["-m", "assocopt", "solve", "instances/example-2d-miss.json"], 1.15),
     ("solve-sd", "assocopt solve instances/example-sd.json",
      ["-m", "assocopt", "solve", "instances/example-sd.json"], 1.4),
+    ("solve-sd-bnb", "assocopt solve instances/example-sd.json --solver bnb",
+     ["-m", "assocopt", "solve", "instances/example-sd.json", "--solver", "bnb"], None),
 ]
 
 
@@ -129,9 +131,14 @@ def render(data: dict[str, Any]) -> str:
         "What loads: `import assocopt` loads the problem, solution and registry modules "
         "(numpy only); a back end's module is imported when it is asked for, and its "
         "optional package (highspy, ortools, cvxpy, numba) inside its `solve`. A 2-D "
-        "solve (`scipy-lsa`) imports `scipy.optimize` and nothing of scipy.sparse's "
-        "callers; a small S-D solve (`bnb`) imports numba and loads only the two "
-        "compiled kernels it calls from numba's on-disk cache.",
+        "solve (`scipy-lsa`) imports `scipy.optimize` and no other back end. "
+        "`assocopt solve` without `--solver` enumerates an S-D problem of at most 64 "
+        "candidates exactly (`bruteforce`, numpy only, at most 20,000 search nodes) "
+        "before it would load numba: one problem per process does not repay the "
+        "kernels' load. The last row is the compiled path that `auto` takes for larger "
+        "problems and in a library process: it imports numba (which imports "
+        "scipy.linalg) and loads from numba's disk cache only the two kernels `bnb` "
+        "calls; its cost is numba's, about `import numba` plus its first-use set-up.",
         "",
     ]
     return "\n".join(lines)

@@ -289,3 +289,29 @@ def test_ensure_times_a_fresh_specialisation():
     kern.ensure(twice, 4.0)
     assert sum(kernels.spent()) == mid and len(twice.overloads) == 1
     assert twice(4.0) == 8.0 and len(twice.overloads) == 1
+
+
+def test_a_bnb_solve_loads_only_the_kernels_it_calls():
+    """In a fresh process, a bnb solve gives ``prepare`` and ``solve`` one
+    specialisation each (loaded from the disk cache, or compiled with their callees on
+    a first run), though the cache may hold others (the window search calls
+    ``prepare`` with other types)."""
+    import json
+    import os
+    import subprocess
+    import sys
+    from pathlib import Path
+
+    root = Path(__file__).resolve().parents[1]
+    code = ("import json, numpy as np\n"
+            "from assocopt import AssignmentProblem, solve\n"
+            "from assocopt.solvers import bnb_kernels as k\n"
+            "p = AssignmentProblem.dense(np.random.default_rng(1).random((4, 4, 4)))\n"
+            "sol = solve(p, 'bnb')\n"
+            "names = ['prepare', 'solve']\n"
+            "print(json.dumps({n: len(getattr(k, n).overloads) for n in names}))\n")
+    env = dict(os.environ, PYTHONPATH=str(root))
+    out = subprocess.run([sys.executable, "-c", code], env=env, capture_output=True,
+                         text=True, check=True, timeout=600).stdout
+    loaded = json.loads(out.splitlines()[-1])
+    assert loaded == {"prepare": 1, "solve": 1}
