@@ -113,7 +113,8 @@ def render(data: dict[str, Any]) -> str:
         "bytecode and numba's kernel cache exist), best of "
         f"{data['rounds']} interleaved rounds. The ratio is to the baseline "
         f"`{data['baseline']}` in the same run, which makes it comparable across "
-        "machines.",
+        "machines. `assocopt ...` runs as `python -m assocopt ...` with the checkout "
+        "first on `PYTHONPATH`, from the repository root.",
         "",
         f"Machine: Python {m['python']}, {m['system']} {m['machine']}, {m['cpus']} CPUs; "
         f"numpy {v['numpy']}, scipy {v['scipy']}, numba {v['numba']}.",

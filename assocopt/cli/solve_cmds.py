@@ -72,7 +72,11 @@ def _compile_note(problem: Any, solver: str, relax: str | None, err: TextIO) -> 
 
 def _compile_done(sol: Any, begun: bool, err: TextIO) -> None:
     """One line on stderr with the compilation time, when the solve compiled kernels."""
-    took = sol.times.get("compile", 0.0) if sol is not None else 0.0
+    if sol is None:              # the solve raised: end the begun line, say no more
+        if begun:
+            print(file=err)
+        return
+    took = sol.times.get("compile", 0.0)
     if begun:
         print(f" done in {took:.1f} s" if took > 0 else " not needed (already compiled)",
               file=err)
