@@ -49,6 +49,9 @@ COMMANDS: list[tuple[str, str, list[str], float | None]] = [
 
 def _env() -> dict[str, str]:
     env = dict(os.environ)
+    # warm means bytecode on disk, as after pip install (which compiles it): let the
+    # unmeasured first run write it even where the environment turns that off
+    env.pop("PYTHONDONTWRITEBYTECODE", None)
     env["PYTHONPATH"] = os.pathsep.join([str(ROOT)] + [p for p in
                                          env.get("PYTHONPATH", "").split(os.pathsep) if p])
     return env
