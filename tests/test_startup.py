@@ -156,3 +156,20 @@ def test_startup_measurements_are_consistent():
             assert r["met"] == (r["ratio"] <= r["target"])
     targets = {key: target for key, _, _, target in bench.COMMANDS}
     assert {k: r["target"] for k, r in rows.items()} == targets
+
+
+def test_every_back_end_module_is_declared():
+    """A back end registered by any module under assocopt/solvers is declared in
+    BACKEND_MODULES (else the lazy registry would not list it until imported)."""
+    code = ("import importlib, pkgutil, json\n"
+            "import assocopt.solvers as s\n"
+            "declared = s.names()\n"
+            "for m in pkgutil.walk_packages(s.__path__, 'assocopt.solvers.'):\n"
+            "    if 'kernels' not in m.name:\n"
+            "        importlib.import_module(m.name)\n"
+            "print(json.dumps([declared, sorted(s.registered())]))\n")
+    env = dict(os.environ, PYTHONPATH=str(ROOT))
+    out = subprocess.run([sys.executable, "-c", code], env=env, check=True,
+                         capture_output=True, text=True).stdout
+    declared, registered = json.loads(out.splitlines()[-1])
+    assert declared == registered and len(declared) >= 12
