@@ -21,6 +21,7 @@ import argparse
 import json
 import os
 import platform
+import resource
 import subprocess
 import sys
 import time
@@ -57,16 +58,20 @@ def _env() -> dict[str, str]:
     return env
 
 
-def time_once(argv: list[str]) -> float:
-    """Wall seconds of one ``python ARGV`` subprocess (it must exit 0)."""
+def time_once(argv: list[str]) -> tuple[float, float]:
+    """Wall seconds and CPU seconds (user + system) of one ``python ARGV`` subprocess
+    (it must exit 0).  CPU time is reported too: it varies far less than wall time
+    on a busy machine."""
+    r0 = resource.getrusage(resource.RUSAGE_CHILDREN)
     t0 = time.perf_counter()
     done = subprocess.run([sys.executable, *argv], cwd=ROOT, env=_env(),
                           stdout=subprocess.DEVNULL, stderr=subprocess.PIPE)
     dt = time.perf_counter() - t0
+    r1 = resource.getrusage(resource.RUSAGE_CHILDREN)
     if done.returncode != 0:
         raise RuntimeError(f"python {' '.join(argv)} exited {done.returncode}: "
                            f"{done.stderr.decode(errors='replace')[-500:]}")
-    return dt
+    return dt, (r1.ru_utime - r0.ru_utime) + (r1.ru_stime - r0.ru_stime)
 
 
 def measure(rounds: int) -> dict[str, Any]:
@@ -74,10 +79,13 @@ def measure(rounds: int) -> dict[str, Any]:
     for _key, _what, argv, _target in COMMANDS:
         time_once(argv)
     times: dict[str, list[float]] = {key: [] for key, *_ in COMMANDS}
+    cpu: dict[str, list[float]] = {key: [] for key, *_ in COMMANDS}
     for _ in range(rounds):
         for key, _what, argv, _target in COMMANDS:
-            times[key].append(time_once(argv))
-    base = min(times["baseline"])
+            wall, used = time_once(argv)
+            times[key].append(wall)
+            cpu[key].append(used)
+    base, base_cpu = min(times["baseline"]), min(cpu["baseline"])
     rows = []
     for key, what, _argv, target in COMMANDS:
         best = min(times[key])
@@ -85,7 +93,9 @@ def measure(rounds: int) -> dict[str, Any]:
         rows.append({"key": key, "command": what, "best_s": round(best, 4),
                      "all_s": [round(t, 4) for t in times[key]],
                      "ratio": round(ratio, 3), "target": target,
-                     "met": None if target is None else bool(ratio <= target)})
+                     "met": None if target is None else bool(ratio <= target),
+                     "cpu_best_s": round(min(cpu[key]), 4),
+                     "cpu_ratio": round(min(cpu[key]) / base_cpu, 3)})
     return {"rounds": rounds, "baseline": f'python -c "{BASELINE}"',
             "machine": {"python": platform.python_version(), "system": platform.system(),
                         "machine": platform.machine(), "cpus": os.cpu_count()},
@@ -116,20 +126,22 @@ def render(data: dict[str, Any]) -> str:
         "bytecode and numba's kernel cache exist), best of "
         f"{data['rounds']} interleaved rounds. The ratio is to the baseline "
         f"`{data['baseline']}` in the same run, which makes it comparable across "
-        "machines. `assocopt ...` runs as `python -m assocopt ...` with the checkout "
+        "machines; the targets apply to it. The CPU columns (user + system time of "
+        "the process, best of the same rounds) vary less on a busy machine. "
+        "`assocopt ...` runs as `python -m assocopt ...` with the checkout "
         "first on `PYTHONPATH`, from the repository root.",
         "",
         f"Machine: Python {m['python']}, {m['system']} {m['machine']}, {m['cpus']} CPUs; "
         f"numpy {v['numpy']}, scipy {v['scipy']}, numba {v['numba']}.",
         "",
-        "| command | best (s) | ratio to baseline | target | met |",
-        "|---|---|---|---|---|",
+        "| command | best (s) | ratio to baseline | target | met | CPU best (s) | CPU ratio |",
+        "|---|---|---|---|---|---|---|",
     ]
     for r in data["rows"]:
         target = "-" if r["target"] is None else f"<= {r['target']:g}x"
         met = "-" if r["met"] is None else ("yes" if r["met"] else "no")
         lines.append(f"| `{r['command']}` | {r['best_s']:.3f} | {r['ratio']:.2f}x | "
-                     f"{target} | {met} |")
+                     f"{target} | {met} | {r['cpu_best_s']:.3f} | {r['cpu_ratio']:.2f}x |")
     lines += [
         "",
         "What loads: `import assocopt` loads the problem, solution and registry modules "
@@ -155,7 +167,8 @@ def main(argv: list[str] | None = None) -> int:
     args = ap.parse_args(argv)
     data = measure(args.rounds)
     for r in data["rows"]:
-        print(f"{r['key']:<10} {r['best_s']:.3f} s  {r['ratio']:.2f}x"
+        print(f"{r['key']:<12} {r['best_s']:.3f} s  {r['ratio']:.2f}x  "
+              f"(CPU {r['cpu_best_s']:.3f} s, {r['cpu_ratio']:.2f}x)"
               + ("" if r["target"] is None else
                  f"  (target {r['target']:g}x: {'met' if r['met'] else 'MISSED'})"))
     if not args.no_write:

@@ -153,6 +153,8 @@ def test_startup_measurements_are_consistent():
         assert len(r["all_s"]) == data["rounds"]
         assert r["best_s"] == pytest.approx(min(r["all_s"]), abs=1e-4)
         assert r["ratio"] == pytest.approx(r["best_s"] / base, abs=2e-3)
+        assert r["cpu_ratio"] == pytest.approx(r["cpu_best_s"] / rows["baseline"][
+            "cpu_best_s"], abs=2e-3)
         if r["target"] is not None:
             assert r["met"] == (r["ratio"] <= r["target"])
     targets = {key: target for key, _, _, target in bench.COMMANDS}
