@@ -94,6 +94,7 @@ def test_one_shot_answer_equals_auto_in_the_library(capsys):
         assert rec["solver"] == "bruteforce" and rec["status"] == "optimal"
         assert rec["objective"] == pytest.approx(ref.objective, abs=1e-9)
         assert "enumerated" in rec["message"]
+        assert rec["info"]["requested"] == "auto" and rec["info"]["one_shot"] is True
 
 
 def test_one_shot_falls_back_when_enumeration_is_too_long(capsys, monkeypatch):

@@ -50,6 +50,7 @@ def _one_shot(problem: Any, relax: str | None) -> Any:
         return None
     sol.message = (f"{sol.message} (auto: one small problem, enumerated rather than "
                    "loading the compiled bnb kernels)")
+    sol.info.update(requested="auto", one_shot=True)
     return sol
 
 
