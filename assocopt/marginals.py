@@ -63,7 +63,7 @@ def marginals(problem: AssignmentProblem, k: int = 100, temperature: float = 1.0
     --------
     >>> from assocopt import AssignmentProblem
     >>> m = marginals(AssignmentProblem.two_d([[0.0, 5.0]], 1.0, 1.0), k=10)
-    >>> m.hypotheses, m.exhaustive, round(float(m.pairs[0, 0] + m.row_miss[0]), 12)
+    >>> m.hypotheses, m.exhaustive, round(float(m.pairs[0].sum() + m.row_miss[0]), 12)
     (3, True, 1.0)
     """
     if not (isinstance(temperature, (int, float)) and math.isfinite(temperature)
