@@ -197,7 +197,11 @@ def render(data: dict) -> str:
              "[benchmarks-2d.json](benchmarks-2d.json); a test re-renders this page from "
              "it).  One process, best of several repeats, the sides interleaved; "
              f"Python {env['python']}, numpy {env['numpy']}, scipy {env['scipy']}, "
-             f"lapx {env['lapx'] or 'not installed'}, {env['machine']}.", "",
+             f"lapx {env['lapx'] or 'not installed'}, {env['machine']}"
+             + (f", load average {env['load_average']} at the start of the last run (a "
+                "shared machine: timings at that load vary by a factor of up to 2 "
+                "between runs; the ratios, taken with both sides interleaved, less so)"
+                if env.get("load_average") is not None else "") + ".", "",
              "## Dense", "",
              "`solve(AssignmentProblem.dense(C))` timed from the constructor on (validation, "
              "solve, the re-check of the answer, the `Solution`) against "
@@ -276,7 +280,8 @@ def environment() -> dict:
         lapx = None
     return {"python": platform.python_version(), "numpy": np.__version__,
             "scipy": scipy.__version__, "lapx": lapx,
-            "machine": f"{platform.machine()}, {__import__('os').cpu_count()} cores"}
+            "machine": f"{platform.machine()}, {__import__('os').cpu_count()} cores",
+            "load_average": round(__import__('os').getloadavg()[0], 1)}
 
 
 def main(argv: list[str] | None = None) -> int:
