@@ -13,10 +13,13 @@ from .problem import AssignmentProblem
 from .solution import Solution, Status
 from . import solvers
 from .api import choose_solver, solve
+from .kbest import Ranked, kbest
+from .marginals import Marginals, marginals
 
 __version__ = "0.1.0"
 
 __all__ = ["AssignmentProblem", "Solution", "Status", "solve", "choose_solver", "solvers",
+           "kbest", "Ranked", "marginals", "Marginals",
            "AssocoptError", "InvalidProblemError", "InstanceFormatError",
            "UnknownSolverError", "SolverNotInstalledError", "SolverCapabilityError",
            "ProblemTooLargeError", "__version__"]

@@ -99,7 +99,8 @@ def solve(problem: AssignmentProblem, solver: str = "auto", *, relax: str | None
     name = choose_solver(problem, relax) if solver == "auto" else solver
     backend_cls = get_backend(name)
     check_capabilities(backend_cls, problem, relax)
-    backend_cls.require()
+    if backend_cls.module is not None and not module_installed(backend_cls.module):
+        backend_cls.require()        # cached lookup first: a scan's solve is microseconds
     parsed = backend_cls.parse_options(options)
     # SolveOptions checks the common options (the one place that does)
     opts = SolveOptions(relax=relax, time_limit=time_limit, mip_gap=mip_gap,
@@ -148,15 +149,20 @@ def _finalise(problem: AssignmentProblem, cls: type[Backend], raw: RawResult,
     for key, name in (("compile_time", "compile"), ("cache_load_time", "cache_load")):
         if key in raw.info:
             sol.times[name] = raw.info[key]
+    tuples = None
     if relax == "lp":
         _finalise_lp(problem, raw, sol)
+    elif raw.col_of_row is not None:
+        checked = problem.dense_view.check(raw.col_of_row)
+        if isinstance(checked, str):
+            return _infeasible_answer(problem, sol, checked)
+        sol.selected, sol.objective, tuples = checked.selected, checked.objective, \
+            checked.tuples
     elif raw.selected is not None:
         sel = np.sort(np.asarray(raw.selected, dtype=np.int64))
         why = problem.violations(sel)
         if why is not None:
-            sol.status = Status.ERROR
-            sol.message = f"back end returned an infeasible assignment: {why}"
-            return sol
+            return _infeasible_answer(problem, sol, why)
         sol.selected = sel
         sol.objective = problem.objective_of(sel)
     if sol.objective is not None and sol.bound is not None and sol.bound > sol.objective:
@@ -164,8 +170,28 @@ def _finalise(problem: AssignmentProblem, cls: type[Backend], raw: RawResult,
     if sol.status is Status.OPTIMAL and sol.bound is None and ran.exact:
         sol.bound = sol.objective
     if sol.selected is not None:
-        sol.tuples = problem.tuples[sol.selected[~problem.slack[sol.selected]]].copy()
+        sol.tuples = tuples if tuples is not None else \
+            problem.tuples[sol.selected[~problem.slack[sol.selected]]].copy()
+    if problem.maximize:
+        to_user_sense(sol)
     return sol
+
+
+def to_user_sense(sol: Solution) -> Solution:
+    """Report a maximisation problem's solution in the user's sense: the problem stores
+    negated scores, so objective and bound change sign (the bound becomes an upper one)."""
+    sol.maximize = True
+    if sol.objective is not None:
+        sol.objective = -sol.objective
+    if sol.bound is not None:
+        sol.bound = -sol.bound
+    return sol
+
+
+def _infeasible_answer(problem: AssignmentProblem, sol: Solution, why: str) -> Solution:
+    sol.status = Status.ERROR
+    sol.message = f"back end returned an infeasible assignment: {why}"
+    return to_user_sense(sol) if problem.maximize else sol
 
 
 def _finalise_lp(problem: AssignmentProblem, raw: RawResult, sol: Solution) -> None:

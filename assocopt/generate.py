@@ -47,7 +47,7 @@ from .solution import Status
 __all__ = ["GENERATORS", "DEFAULT_SIZES", "generate", "generate_dense", "generate_sparse",
            "generate_planted", "prove_optimum", "feasibility", "catalogue", "write_index",
            "default_instances_dir", "find_stored_instance", "INDEX_NAME",
-           "PACKAGED_INSTANCES"]
+           "PACKAGED_INSTANCES", "gated_2d"]
 
 #: Generator names accepted by :func:`generate`.
 GENERATORS = ("dense", "sparse", "planted")
@@ -349,3 +349,30 @@ def write_index(directory: str | os.PathLike[str]) -> Path:
             w.writerow({**r, "sizes": "x".join(map(str, r["sizes"])),
                         "optimum": "" if r["optimum"] is None else f"{r['optimum']:.17g}"})
     return path
+
+
+def gated_2d(n: int, k: int, *, seed: int, miss: float = 6.0,
+             n_cols: int | None = None) -> AssignmentProblem:
+    """A gated 2-D tracking scan: ``n`` tracks, ``n_cols`` (default ``n``) measurements,
+    each track gated to ``k`` distinct nearby measurements at chi-square(2) costs (squared
+    normalised distances), every track and measurement may stay unassigned at ``miss``.
+
+    Built as a candidate list (``AssignmentProblem.sparse``), never as a matrix, so
+    ``n = 10^5`` is cheap.
+    """
+    m = n if n_cols is None else int(n_cols)
+    if n < 0 or m < 0 or not 1 <= k <= m:
+        raise InvalidProblemError(f"gated_2d needs n >= 0 and 1 <= k <= n_cols, "
+                                  f"got n={n}, k={k}, n_cols={m}")
+    rng = np.random.default_rng(seed)
+    width = min(m, 4 * k)
+    off = np.argsort(rng.random((n, width)), axis=1)[:, :k]
+    centre = (np.arange(n) * m) // max(n, 1)
+    cols = (centre[:, None] + off - width // 2) % m
+    rows = np.repeat(np.arange(n), k)
+    pairs = np.stack([rows + 1, cols.ravel() + 1], axis=1)
+    misses_r = np.stack([np.arange(1, n + 1), np.zeros(n, np.int64)], axis=1)
+    misses_c = np.stack([np.zeros(m, np.int64), np.arange(1, m + 1)], axis=1)
+    costs = np.concatenate([rng.chisquare(2, n * k), np.full(n + m, float(miss))])
+    return AssignmentProblem.sparse((n, m), np.concatenate([pairs, misses_r, misses_c]),
+                                    costs, name=f"gated-2d-n{n}-k{k}-s{seed}")

@@ -25,6 +25,7 @@ solver.  NaN and ``-inf`` are errors.
 from __future__ import annotations
 
 import functools
+import math
 
 from dataclasses import dataclass, field
 from typing import Any, Sequence
@@ -34,26 +35,10 @@ from numpy.typing import ArrayLike
 
 from .errors import InvalidProblemError
 from .indexing import OPT_TOL, IndexArithmetic, index_label, kept_axes
+from .twod import MAX_DENSE_CANDIDATES, LazyView, from_matrix, miss_vector
+from .values import _as_cost_array, _as_matrix, _reject_non_finite
 
-__all__ = ["AssignmentProblem", "OPT_TOL", "kept_axes", "index_label"]
-
-#: Largest number of candidates a dense constructor will enumerate.
-MAX_DENSE_CANDIDATES = 50_000_000
-
-
-def _as_cost_array(values: ArrayLike, what: str) -> np.ndarray:
-    """Return ``values`` as float64, rejecting NaN and -inf (``+inf`` = forbidden)."""
-    try:
-        arr = np.array(values, dtype=np.float64)
-    except (TypeError, ValueError) as exc:
-        raise InvalidProblemError(f"{what} must be numeric: {exc}") from exc
-    if np.isnan(arr).any():
-        where = tuple(int(i) for i in np.argwhere(np.isnan(arr))[0])
-        raise InvalidProblemError(f"{what} contains NaN (first at index {where})")
-    if np.isneginf(arr).any():
-        where = tuple(int(i) for i in np.argwhere(np.isneginf(arr))[0])
-        raise InvalidProblemError(f"{what} contains -inf (first at index {where})")
-    return arr
+__all__ = ["AssignmentProblem", "OPT_TOL", "kept_axes", "index_label", "MAX_DENSE_CANDIDATES"]
 
 
 def _freeze(arr: np.ndarray) -> np.ndarray:
@@ -80,6 +65,10 @@ class AssignmentProblem(IndexArithmetic):
         cost 0 and are left out of reported solutions.
     kind : str
         ``"dense"``, ``"two_d"`` or ``"sparse"``: how the problem was built.
+    maximize : bool
+        Built with ``maximize=True``: the given values are scores to maximise; the
+        problem stores them negated (``costs`` is always in the minimisation sense)
+        and :class:`~assocopt.Solution` reports objective and bound in the user's sense.
     name : str or None
     optimum : float or None
         A recorded, proven optimum (from an instance file), used for checks only.
@@ -100,17 +89,27 @@ class AssignmentProblem(IndexArithmetic):
     name: str | None = None
     optimum: float | None = None
     meta: dict[str, Any] = field(default_factory=dict)
+    maximize: bool = False
+    #: The dense 2-D view (:class:`assocopt.twod.Dense2D`) when built from a matrix.
+    _dense: Any = field(default=None, init=False, repr=False)
 
     # ------------------------------------------------------------------ builders
     @classmethod
     def dense(cls, costs: ArrayLike, *, name: str | None = None,
-              optimum: float | None = None) -> "AssignmentProblem":
+              optimum: float | None = None, maximize: bool = False) -> "AssignmentProblem":
         """Axial assignment on a full ``n_1 x ... x n_N`` cost array (N >= 2).
 
         The smallest axis is assigned completely; surplus indices of larger axes
         stay unassigned at no cost.  ``+inf`` entries are forbidden tuples.
+        ``maximize=True``: the values are scores (log-likelihoods...) to maximise, as
+        scipy's ``maximize``; ``-inf`` is then forbidden.  A 2-D matrix is kept as
+        given (no candidate list until a back end needs one).
         """
-        C = _as_cost_array(costs, "cost array")
+        C, all_finite = _as_matrix(costs, "cost array", maximize)
+        if C.ndim == 2:
+            return from_matrix(cls, C, None, None, all_finite, kind="dense", name=name,
+                                    optimum=optimum, maximize=maximize)
+        _reject_non_finite(C, "cost array", maximize)
         if C.ndim < 2:
             raise InvalidProblemError(
                 f"cost array must have at least 2 dimensions, got shape {C.shape}")
@@ -134,60 +133,52 @@ class AssignmentProblem(IndexArithmetic):
         slack = np.zeros(sum(len(c) for c in costs_list), dtype=bool)
         slack[len(costs_list[0]):] = True
         return cls._build(sizes, np.concatenate(tuples), np.concatenate(costs_list),
-                          slack, kind="dense", name=name, optimum=optimum)
+                          slack, kind="dense", name=name, optimum=optimum,
+                          maximize=maximize)
 
     @classmethod
     def two_d(cls, costs: ArrayLike, row_miss: ArrayLike | None = None,
               col_miss: ArrayLike | None = None, *, name: str | None = None,
-              optimum: float | None = None) -> "AssignmentProblem":
+              optimum: float | None = None, maximize: bool = False) -> "AssignmentProblem":
         """2-D assignment of an ``n1 x n2`` cost matrix with non-assignment costs.
 
         Row ``i`` left unassigned costs ``row_miss[i]``, column ``j`` costs
         ``col_miss[j]`` (scalars broadcast).  ``inf`` forbids leaving it
         unassigned.  With neither given this is :meth:`dense` (the smaller side
         fully assigned); with only one given, the other side must be assigned.
+        ``maximize=True``: matrix and misses are scores to maximise (``-inf`` forbids).
         """
-        C = _as_cost_array(costs, "cost matrix")
+        C, all_finite = _as_matrix(costs, "cost matrix", maximize)
         if C.ndim != 2:
             raise InvalidProblemError(f"cost matrix must be 2-D, got shape {C.shape}")
         if row_miss is None and col_miss is None:
-            return cls.dense(C, name=name, optimum=optimum)
+            return from_matrix(cls, C, None, None, all_finite, kind="dense", name=name,
+                                    optimum=optimum, maximize=maximize)
         n1, n2 = C.shape
-        rm = np.full(n1, np.inf) if row_miss is None else cls._miss(row_miss, n1, "row_miss")
-        cm = np.full(n2, np.inf) if col_miss is None else cls._miss(col_miss, n2, "col_miss")
-        finite = np.isfinite(C)
-        pairs = np.stack(np.nonzero(finite), axis=1).astype(np.int64) + 1
-        r = np.flatnonzero(np.isfinite(rm))
-        c = np.flatnonzero(np.isfinite(cm))
-        row_t = np.stack([r + 1, np.zeros_like(r)], axis=1)
-        col_t = np.stack([np.zeros_like(c), c + 1], axis=1)
-        tuples = np.concatenate([pairs, row_t, col_t]).astype(np.int64)
-        costs_ = np.concatenate([C[finite], rm[r], cm[c]])
-        return cls._build((n1, n2), tuples, costs_, np.zeros(len(costs_), bool),
-                          kind="two_d", name=name, optimum=optimum)
+        (rm, fr), (cm, fc) = (miss_vector(row_miss, n1, "row_miss", maximize),
+                              miss_vector(col_miss, n2, "col_miss", maximize))
+        return from_matrix(cls, C, rm, cm, all_finite, (fr, fc), kind="two_d", name=name,
+                           optimum=optimum, maximize=maximize)
 
-    @staticmethod
-    def _miss(values: ArrayLike, n: int, what: str) -> np.ndarray:
-        arr = _as_cost_array(values, what)
-        if arr.ndim == 0:
-            return np.full(n, float(arr))
-        if arr.shape != (n,):
-            raise InvalidProblemError(f"{what} must be a scalar or have shape ({n},), "
-                                      f"got shape {arr.shape}")
-        return arr
+    @property
+    def dense_view(self) -> Any:
+        """The :class:`assocopt.twod.Dense2D` of a problem built from a 2-D matrix, else None."""
+        return self._dense
 
     @classmethod
     def sparse(cls, sizes: Sequence[int], tuples: ArrayLike, costs: ArrayLike, *,
-               name: str | None = None, optimum: float | None = None) -> "AssignmentProblem":
+               name: str | None = None, optimum: float | None = None,
+               maximize: bool = False) -> "AssignmentProblem":
         """General S-D problem from candidate tuples (index 0 = dummy) and costs.
 
-        Candidates with ``+inf`` cost are dropped.  Indices must be integers in
+        Candidates with ``+inf`` cost are dropped (``-inf`` with ``maximize=True``,
+        where ``costs`` are scores to maximise).  Indices must be integers in
         ``0..n_s``; duplicate tuples and the all-dummy tuple are errors.
         """
         sizes_t = cls._check_sizes(sizes)
         N = len(sizes_t)
         T = cls._check_tuples(tuples, sizes_t)
-        c = _as_cost_array(costs, "costs")
+        c = _as_cost_array(costs, "costs", maximize)
         if c.ndim != 1 or len(c) != len(T):
             raise InvalidProblemError(
                 f"costs must have shape ({len(T)},) to match tuples of shape "
@@ -195,7 +186,7 @@ class AssignmentProblem(IndexArithmetic):
         keep = np.isfinite(c)
         T, c = T[keep], c[keep]
         return cls._build(sizes_t, T, c, np.zeros(len(c), bool), kind="sparse",
-                          name=name, optimum=optimum)
+                          name=name, optimum=optimum, maximize=maximize)
 
     @staticmethod
     def _check_sizes(sizes: Sequence[int]) -> tuple[int, ...]:
@@ -267,6 +258,8 @@ class AssignmentProblem(IndexArithmetic):
     @property
     def n_candidates(self) -> int:
         """K, the number of candidate tuples (slack included)."""
+        if self._dense is not None:
+            return self._dense.n_candidates
         return len(self.costs)
 
     @property
@@ -281,6 +274,11 @@ class AssignmentProblem(IndexArithmetic):
         off = np.concatenate([[0], np.cumsum(self.sizes)[:-1]]).astype(np.int64)
         off.setflags(write=False)
         return off
+
+    def uncovered(self) -> list[tuple[int, int]]:
+        """Real indices ``(axis, index)`` that no candidate covers (1-based index); for
+        a dense 2-D problem read from the matrix, without building the candidate list."""
+        return self._dense.uncovered() if self._dense is not None else super().uncovered()
 
     # ------------------------------------------------------------- solutions
     def violations(self, selected: ArrayLike) -> str | None:
@@ -305,8 +303,15 @@ class AssignmentProblem(IndexArithmetic):
         import math
         return math.fsum(self.costs[np.asarray(selected, dtype=np.int64)].tolist())
 
+    def value_of(self, selected: ArrayLike) -> float:
+        """:meth:`objective_of` in the user's sense (scores' sum for ``maximize=True``)."""
+        v = self.objective_of(selected)
+        return -v if self.maximize else v
+
     def to_cost_matrix(self, fill: float = np.inf) -> np.ndarray:
         """Dense array of the all-real candidates' costs (``fill`` elsewhere)."""
+        if self._dense is not None and fill == np.inf:
+            return self._dense.C.copy()
         M = np.full(self.sizes, fill, dtype=np.float64)
         real = (self.tuples > 0).all(axis=1)
         M[tuple((self.tuples[real] - 1).T)] = self.costs[real]
@@ -316,6 +321,8 @@ class AssignmentProblem(IndexArithmetic):
         """For a 2-D problem: ``(row_miss, col_miss)`` with ``inf`` where forbidden."""
         if self.ndim != 2:
             raise InvalidProblemError("miss costs are defined for 2-D problems only")
+        if self._dense is not None:
+            return self._dense.rm.copy(), self._dense.cm.copy()
         rm = np.full(self.sizes[0], np.inf)
         cm = np.full(self.sizes[1], np.inf)
         T = self.tuples
@@ -329,3 +336,8 @@ class AssignmentProblem(IndexArithmetic):
         label = f" {self.name!r}" if self.name else ""
         return (f"<AssignmentProblem{label} kind={self.kind} sizes={self.sizes} "
                 f"candidates={self.n_candidates}>")
+
+
+for _name in ("tuples", "costs", "slack"):
+    setattr(AssignmentProblem, _name, LazyView(_name))
+del _name

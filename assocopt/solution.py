@@ -57,7 +57,8 @@ class Solution:
         Cost of the returned solution, recomputed from the problem's costs (never
         taken on trust from the back end).  For ``relax="lp"``, the LP optimum.
     bound : float or None
-        A proven lower bound on the optimum, where the method gives one.
+        A proven bound on the optimum, where the method gives one: a lower bound, or an
+        upper bound for a problem built with ``maximize=True``.
     selected : ndarray of int64 or None
         Positions of the chosen candidates in ``problem.tuples`` (slack included).
     tuples : ndarray of int64, shape (k, N), or None
@@ -79,7 +80,10 @@ class Solution:
     message : str
         Human-readable detail (the back end's own status text where useful).
     info : dict
-        Method-specific values that were used (scaling, options...), for records.
+        Method-specific values that were used (scaling, options...), for records
+        (in the minimisation sense: negated scores for a maximisation problem).
+    maximize : bool
+        The problem maximises: ``objective`` and ``bound`` are in the scores' sense.
     """
 
     status: Status
@@ -95,10 +99,13 @@ class Solution:
     integral: bool | None = None
     message: str = ""
     info: dict[str, Any] = field(default_factory=dict)
+    maximize: bool = False
 
     @property
     def gap(self) -> float | None:
         """Relative gap between :attr:`objective` and :attr:`bound` (None if no bound)."""
+        if self.maximize and self.objective is not None and self.bound is not None:
+            return relative_gap(-self.objective, -self.bound)
         return relative_gap(self.objective, self.bound)
 
     @property
@@ -131,6 +138,7 @@ class Solution:
             "gap": num(self.gap),
             "solver": self.solver,
             "solver_version": self.solver_version,
+            "maximize": self.maximize,
             "relaxation": self.relaxation,
             "integral": self.integral,
             "tuples": None if self.tuples is None else self.tuples.tolist(),

@@ -193,7 +193,7 @@ def assert_feasible(problem: AssignmentProblem, solution: Solution) -> None:
         f"no solution attached: status={solution.status}, message={solution.message!r}")
     why = problem.violations(solution.selected)
     assert why is None, f"infeasible solution from {solution.solver}: {why}"
-    total = problem.objective_of(solution.selected)
+    total = problem.value_of(solution.selected)
     assert math.isclose(total, solution.objective, rel_tol=1e-9, abs_tol=1e-9), (
         f"objective {solution.objective} != sum of chosen costs {total}")
 
@@ -237,13 +237,15 @@ def assert_optimal(problem: AssignmentProblem, solution: Solution, *,
     assert math.isclose(solution.objective, ref, rel_tol=rel, abs_tol=abs_tol), (
         f"{solution.solver}: objective {solution.objective!r} != {how} {ref!r} "
         f"({solution.message})")
-    if solution.bound is not None:
-        assert solution.bound <= solution.objective + abs_tol + rel * abs(ref)
+    if solution.bound is not None:     # a lower bound; an upper one when maximising
+        sign = -1.0 if problem.maximize else 1.0
+        assert sign * solution.bound <= sign * solution.objective + abs_tol + rel * abs(ref)
 
 
 def assert_valid_bound(problem: AssignmentProblem, solution: Solution, *,
                        rel: float = 1e-9, abs_tol: float = 1e-9) -> None:
-    """Assert the lower bound of ``solution`` does not exceed the optimum.
+    """Assert the lower bound of ``solution`` does not exceed the optimum (for a
+    ``maximize=True`` problem: the upper bound is not below it).
 
     The bound is ``solution.bound``, or for an LP relaxation its objective.  Use it
     for relaxations and heuristics whose answers need not be optimal.
@@ -255,7 +257,8 @@ def assert_valid_bound(problem: AssignmentProblem, solution: Solution, *,
         f"{solution.solver}: no bound reported (status {solution.status}, "
         f"message {solution.message!r})")
     ref, how = _reference_optimum(problem)
-    assert bound <= ref + abs_tol + rel * abs(ref), (
+    sign = -1.0 if problem.maximize else 1.0
+    assert sign * bound <= sign * ref + abs_tol + rel * abs(ref), (
         f"{solution.solver}: bound {bound!r} exceeds the {how} {ref!r} ({solution.message})")
 
 

@@ -86,9 +86,41 @@ def _compile_done(sol: Any, begun: bool, err: TextIO) -> None:
               "cached afterwards)", file=err)
 
 
+def _cmd_kbest(args: argparse.Namespace, out: TextIO, err: TextIO) -> int:
+    """``solve --kbest K``: the K best solutions, as a table or one JSON object."""
+    from ..io import read_instance
+    from ..kbest import kbest
+
+    for flag in ("model", "relax", "out", "time_limit", "gap", "threads"):
+        if getattr(args, flag, None) is not None:
+            raise AssocoptError(f"--kbest does not combine with --{flag.replace('_', '-')}")
+    if args.kbest < 1:
+        raise AssocoptError(f"--kbest must be a positive integer, got {args.kbest}")
+    problem = read_instance(args.file, format=args.format, instance=args.instance)
+    _compile_note(problem, args.solver or "auto", None, err)
+    ranked = kbest(problem, args.kbest, args.solver or "auto")
+    if args.json:
+        rec = {"instance": problem.name, "sizes": list(problem.sizes), **ranked.to_dict()}
+        print(json.dumps(rec, allow_nan=False), file=out)
+    else:
+        note = " (all feasible solutions)" if ranked.exhausted else ""
+        print(f"instance   {problem.name}  (sizes {' x '.join(map(str, problem.sizes))})",
+              file=out)
+        print(f"kbest      {len(ranked)} of {ranked.k} requested{note}, solver "
+              f"{ranked.solver}, {ranked.subproblems} subproblems, "
+              f"{ranked.times['total']:.3g} s", file=out)
+        for s in ranked:
+            tup = " ".join("(" + ",".join(map(str, t)) + ")" for t in s.tuples.tolist())
+            print(f"{s.info['rank']:>4}  {_num(s.objective):>14}  {tup}", file=out)
+    return EXIT_OK if len(ranked) else 1
+
+
 def _cmd_solve(args: argparse.Namespace, out: TextIO, err: TextIO) -> int:
     from ..api import solve
     from ..io import read_instance, write_solution
+
+    if getattr(args, "kbest", None) is not None:
+        return _cmd_kbest(args, out, err)
 
     if args.model is not None:
         from ..models import load_model

@@ -86,7 +86,9 @@ class RawResult:
     ``build_time`` / ``solve_time``: seconds spent building the back end's model
     and inside the back end's solve call; ``solver``: the method that produced the
     answer when it is not the back end that was called (a fallback; its name is then
-    reported as ``Solution.solver``).
+    reported as ``Solution.solver``);
+    ``col_of_row``: instead of ``selected``, for a problem with a dense 2-D view
+    (:attr:`AssignmentProblem.dense_view`): the column of each row, ``-1`` = left out.
     """
 
     status: Status
@@ -99,6 +101,7 @@ class RawResult:
     build_time: float = 0.0
     solve_time: float = 0.0
     solver: str = ""
+    col_of_row: np.ndarray | None = None
 
 
 @functools.lru_cache(maxsize=None)

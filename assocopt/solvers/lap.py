@@ -287,10 +287,9 @@ def assignment_duals(size: int, rows: np.ndarray, cols: np.ndarray, weights: np.
 class LapjvBackend(Backend):
     """Exact 2-D assignment with lapx's Jonker-Volgenant code (optional package).
 
-    Same cases as ``scipy-lsa`` (plain, transposed, augmented with miss costs); gated
-    problems whose augmented matrix would be large and sparse use scipy's sparse
-    LAPJVsp instead.  Extra option ``method``: ``"auto"`` (default), ``"lapx"`` or
-    ``"sparse"``.
+    Same cases as ``scipy-lsa`` (:mod:`assocopt.solvers.dense2d`); large gated
+    candidate lists use the sparse engine (:mod:`assocopt.solvers.sparse2d`).  Extra
+    option ``method``: ``"auto"`` (default), ``"lapx"`` or ``"sparse"``.
     """
 
     name = "lapjv"
@@ -303,45 +302,11 @@ class LapjvBackend(Backend):
                       choices=("auto", "lapx", "sparse")),)
 
     def solve(self, problem: AssignmentProblem, options: SolveOptions) -> RawResult:
-        from .scipy_lsa import ScipyLsaBackend, _positions
+        from .dense2d import solve_2d
 
         method = self.settings(problem, options)["method"]
-        lap_method = "lapx" if method == "auto" else method
-        t0 = time.perf_counter()
-        n1, n2 = problem.sizes
-        T, c = problem.tuples, problem.costs
-        both = (T[:, 0] > 0) & (T[:, 1] > 0)
-        rm, cm = problem.miss_costs()
-        mode = ScipyLsaBackend._mode(problem, rm, cm)
-        r_e, c_e, w_e = T[both, 0] - 1, T[both, 1] - 1, c[both]
-        t1 = time.perf_counter()
-        try:
-            if mode in ("plain", "transposed") and method != "sparse":
-                M = _dense(n1, n2, r_e, c_e, w_e)
-                r, cc = linear_assignment(M.T if mode == "transposed" else M, lap_method)
-                if mode == "transposed":
-                    r, cc = cc, r
-                pairs = ScipyLsaBackend._with_slack(np.stack([r + 1, cc + 1], axis=1), n1, n2)
-                how = "plain"
-            else:
-                a = assign_with_misses(n1, n2, r_e, c_e, w_e, rm, cm, method=lap_method)
-                i = np.arange(n1)
-                j = np.arange(n2)
-                m = a.col_of_row >= 0
-                pairs = np.concatenate([
-                    np.stack([i[m] + 1, a.col_of_row[m] + 1], axis=1),
-                    np.stack([i[~m] + 1, np.zeros((~m).sum(), np.int64)], axis=1),
-                    np.stack([np.zeros((a.row_of_col < 0).sum(), np.int64),
-                              j[a.row_of_col < 0] + 1], axis=1)]).astype(np.int64)
-                how = a.method
-        except LapInfeasibleError as exc:
-            return RawResult(Status.INFEASIBLE, message=f"lapjv: infeasible ({exc})",
-                             build_time=t1 - t0, solve_time=time.perf_counter() - t1)
-        t2 = time.perf_counter()
-        selected = _positions(problem, pairs)
-        msg = "lapjv: optimal"
-        if options.time_limit is not None:
-            msg += " (time_limit not supported by lapjv; ran to completion)"
-        return RawResult(Status.OPTIMAL, selected=selected, message=msg,
-                         info={"lap_method": how, "lapx_version": self.version()},
-                         build_time=t1 - t0, solve_time=t2 - t1)
+        mode = {"auto": "auto", "lapx": "dense", "sparse": "sparse"}[method]
+        raw = solve_2d(problem, options, "lapx", self.name, mode)
+        raw.info["lap_method"] = raw.info.pop("lsa_mode", None)
+        raw.info["lapx_version"] = self.version()
+        return raw

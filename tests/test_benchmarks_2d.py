@@ -1,0 +1,38 @@
+"""docs/benchmarks-2d.md is exactly what benchmarks/twod.py renders from the committed JSON."""
+
+from __future__ import annotations
+
+import importlib.util
+import json
+from pathlib import Path
+
+ROOT = Path(__file__).resolve().parents[1]
+
+
+def _bench():
+    spec = importlib.util.spec_from_file_location("bench_twod", ROOT / "benchmarks" / "twod.py")
+    mod = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(mod)
+    return mod
+
+
+def test_page_matches_the_committed_json():
+    data = json.loads((ROOT / "docs" / "benchmarks-2d.json").read_text())
+    page = (ROOT / "docs" / "benchmarks-2d.md").read_text()
+    assert _bench().render(data) == page
+
+
+def test_committed_results_agree_with_the_references():
+    data = json.loads((ROOT / "docs" / "benchmarks-2d.json").read_text())
+    assert {r["n"] for r in data["dense"]} >= {10, 100, 1000, 2000}
+    assert all(r["equal"] for r in data["dense"] + data["sparse"] + data["kbest"])
+    for r in data["marginals"]:
+        assert 0.0 <= r["max_abs_error"] <= 1.0 and 0.0 < r["min_mass_covered"] <= 1.0
+
+
+def test_quick_run_writes_a_consistent_page(tmp_path):
+    bench = _bench()
+    assert bench.main(["--quick", "--out", str(tmp_path)]) == 0
+    data = json.loads((tmp_path / "benchmarks-2d.json").read_text())
+    assert bench.render(data) == (tmp_path / "benchmarks-2d.md").read_text()
+    assert all(r["equal"] for r in data["dense"] + data["sparse"] + data["kbest"])
