@@ -5,7 +5,14 @@
 * :mod:`.belief` -- belief (mass) functions and combination rules;
 * :mod:`.group_matching` -- matching measures between two sensors' group observations;
 * :mod:`.decide` -- decision rules (MD-ND truncation, MD-2DA);
-* :mod:`.scenarios` -- the simulated scenarios of the papers (Lu 2013, Zhang 2009).
+* :mod:`.scenarios` -- the simulated scenarios of the papers (Lu 2013, Zhang 2009);
+* :mod:`.gating` -- chi-square gating of track-measurement pairs (KD-tree pre-filter);
+* :mod:`.costs.kinematic` -- Mahalanobis and log-likelihood-ratio costs of gated pairs;
+* :mod:`.sd_gating` -- S-D candidate tuples gated pairwise across sensors;
+* :mod:`.azimuth` -- azimuth-only sensors in the plane;
+* :mod:`.simulate` -- a seeded constant-velocity scenario with clutter;
+* :mod:`.stonesoup` -- assocopt as a Stone Soup data associator (optional extra).
 
-Nothing is imported here, so ``import assocopt.tracking.costs`` loads only what it needs.
+Nothing is imported here, so ``import assocopt.tracking.costs`` loads only what it needs
+(and importing this package never imports Stone Soup).
 """
