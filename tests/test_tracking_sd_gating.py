@@ -1,0 +1,102 @@
+"""Pairwise-gated S-D tuples against brute-force enumeration + filter."""
+
+from __future__ import annotations
+
+import itertools
+
+import numpy as np
+import pytest
+from hypothesis import given, strategies as st
+
+from assocopt.costs.sd_builder import candidate_tuples, tuple_costs, tuple_geometry
+from assocopt.errors import InvalidProblemError
+from assocopt.localise import angles
+from assocopt.scenarios.lu2013 import Lu2013
+from assocopt.tracking.sd_gating import bearing_pair_gate, build_gated_problem, gated_tuples
+
+FIVE = ((0.0, 20.0, 0.0), (20.0, 0.0, 0.0), (0.0, 0.0, 0.0), (-20.0, 0.0, 0.0),
+        (0.0, -20.0, 0.0))
+
+
+def _brute(sizes, ok, pd, cd):
+    """Every candidate of the detection model, kept when all its real pairs are compatible."""
+    T = candidate_tuples(sizes, pd, cd)
+    keep = []
+    for t in T.tolist():
+        good = all(ok[(s, u)][t[s] - 1, t[u] - 1]
+                   for s, u in itertools.combinations(range(len(sizes)), 2)
+                   if t[s] > 0 and t[u] > 0 and (s, u) in ok)
+        keep.append(good)
+    return {tuple(t) for t, k in zip(T.tolist(), keep) if k}
+
+
+@given(st.integers(0, 10_000), st.integers(2, 4), st.booleans(), st.booleans())
+def test_gated_tuples_equal_brute_force(seed, N, miss, clutter):
+    rng = np.random.default_rng(seed)
+    sizes = tuple(int(v) for v in rng.integers(0, 4, size=N))
+    pd = np.where(rng.random(N) < 0.5, 1.0, 0.8) if miss else np.ones(N)
+    cd = rng.choice([0.0, 0.5], size=N) if clutter else np.zeros(N)
+    ok = {(s, t): rng.random((sizes[s], sizes[t])) < 0.5
+          for s, t in itertools.combinations(range(N), 2) if rng.random() < 0.8}
+    got = gated_tuples(sizes, ok, pd, cd)
+    assert {tuple(t) for t in got.tolist()} == _brute(sizes, ok, pd, cd)
+    assert len(got) == len({tuple(t) for t in got.tolist()})      # no duplicates
+    assert (got == got[np.lexsort(got.T[::-1])]).all()
+
+
+@pytest.mark.parametrize("pd, clutter", [(1.0, 0.0), (0.8, 1.0)])
+def test_gated_problem_equals_brute_force_tuples_and_costs(pd, clutter):
+    sc = Lu2013(n_targets=3, d=2.0, sensors_km=FIVE[:4], pd=pd, clutter_rate=clutter)
+    scan, _ = sc.simulate(np.random.default_rng(11))
+    ok = bearing_pair_gate(scan, probability=0.99)
+    want = np.array(sorted(_brute(scan.sizes, ok, scan.pd, scan.clutter_density)))
+    g = tuple_geometry(scan, want)
+    c = tuple_costs(scan, g, "skld-exact")
+    keep = np.isfinite(c.total)
+    p = build_gated_problem(scan, "skld-exact", probability=0.99, name="mine")
+    got = dict(zip(map(tuple, p.tuples.tolist()), p.costs.tolist()))
+    assert got == pytest.approx(dict(zip(map(tuple, want[keep].tolist()),
+                                         c.total[keep].tolist())))
+    assert p.name == "mine"
+    assert p.n_candidates < len(candidate_tuples(scan.sizes, scan.pd, scan.clutter_density))
+
+
+def test_true_pairs_pass_the_pair_gate_and_far_ones_do_not():
+    rng = np.random.default_rng(3)
+    X = np.array([[10.0, 12.0, 5.0], [-15.0, 30.0, 8.0]])
+    S = np.array(FIVE[:2])
+    th = angles(X, S)                                          # (2 targets, 2 sensors, 2)
+    from assocopt.costs.sd_builder import Scan
+    sig = 1e-3
+    meas = [th[:, s] + rng.normal(0, sig, size=(2, 2)) for s in range(2)]
+    scan = Scan.create(S, meas, np.eye(2) * sig ** 2)
+    ok = bearing_pair_gate(scan, probability=0.999)[(0, 1)]
+    assert ok[0, 0] and ok[1, 1] and not ok[0, 1] and not ok[1, 0]
+
+
+def test_behind_and_max_range_gates_in_the_plane():
+    from assocopt.costs.sd_builder import Scan
+    S = np.array([[0.0, 0.0], [10.0, 0.0]])
+    # target at (5, 5): azimuths 45 deg from sensor 0, 135 deg from sensor 1;
+    # the second measurement of sensor 1 points away (-45 deg): its lines meet behind it
+    meas = [np.array([np.pi / 4]), np.array([3 * np.pi / 4, -np.pi / 4])]
+    scan = Scan.create(S, meas, 1e-6)
+    ok = bearing_pair_gate(scan)[(0, 1)]
+    assert ok.tolist() == [[True, False]]
+    assert bearing_pair_gate(scan, max_range=5.0)[(0, 1)].tolist() == [[False, False]]
+
+
+def test_thirty_targets_five_sensors_without_enumerating_every_tuple():
+    sc = Lu2013(n_targets=30, d=3.0, sensors_km=FIVE, pd=0.9, clutter_rate=1.0)
+    scan, truth = sc.simulate(np.random.default_rng(5))
+    p = build_gated_problem(scan, probability=0.99)
+    full = np.prod(np.array(scan.sizes) + 1)
+    assert full > 10_000_000 and p.n_candidates < full / 100
+    assert not p.uncovered()
+
+
+def test_bad_compatibility_is_named():
+    with pytest.raises(InvalidProblemError, match=r"sensors \(0, 1\) must have shape"):
+        gated_tuples((2, 2), {(0, 1): np.ones((3, 2), bool)}, 1.0)
+    with pytest.raises(InvalidProblemError, match="must be a sensor pair"):
+        gated_tuples((2, 2), {(1, 0): np.ones((2, 2), bool)}, 1.0)
