@@ -8,10 +8,10 @@ import numpy as np
 import pytest
 from hypothesis import given, strategies as st
 
-from assocopt.costs.sd_builder import candidate_tuples, tuple_costs, tuple_geometry
+from assocopt.tracking.costs.sd_builder import candidate_tuples, tuple_costs, tuple_geometry
 from assocopt.errors import InvalidProblemError
-from assocopt.localise import angles
-from assocopt.scenarios.lu2013 import Lu2013
+from assocopt.tracking.localisation import angles
+from assocopt.tracking.scenarios.lu2013 import Lu2013
 from assocopt.tracking.sd_gating import bearing_pair_gate, build_gated_problem, gated_tuples
 
 FIVE = ((0.0, 20.0, 0.0), (20.0, 0.0, 0.0), (0.0, 0.0, 0.0), (-20.0, 0.0, 0.0),
@@ -66,7 +66,7 @@ def test_true_pairs_pass_the_pair_gate_and_far_ones_do_not():
     X = np.array([[10.0, 12.0, 5.0], [-15.0, 30.0, 8.0]])
     S = np.array(FIVE[:2])
     th = angles(X, S)                                          # (2 targets, 2 sensors, 2)
-    from assocopt.costs.sd_builder import Scan
+    from assocopt.tracking.costs.sd_builder import Scan
     sig = 1e-3
     meas = [th[:, s] + rng.normal(0, sig, size=(2, 2)) for s in range(2)]
     scan = Scan.create(S, meas, np.eye(2) * sig ** 2)
@@ -75,7 +75,7 @@ def test_true_pairs_pass_the_pair_gate_and_far_ones_do_not():
 
 
 def test_behind_and_max_range_gates_in_the_plane():
-    from assocopt.costs.sd_builder import Scan
+    from assocopt.tracking.costs.sd_builder import Scan
     S = np.array([[0.0, 0.0], [10.0, 0.0]])
     # target at (5, 5): azimuths 45 deg from sensor 0, 135 deg from sensor 1;
     # the second measurement of sensor 1 points away (-45 deg): its lines meet behind it

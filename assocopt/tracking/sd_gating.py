@@ -17,7 +17,7 @@ computed for the survivors only.
   with the redundant degrees of freedom;
 * :func:`build_gated_problem` -- the gated S-D problem of a bearing scan.
 
-The detection model of :func:`assocopt.costs.sd_builder.candidate_tuples` is kept:
+The detection model of :func:`assocopt.tracking.costs.sd_builder.candidate_tuples` is kept:
 a dummy in sensor ``s`` needs ``P_Ds < 1``, and a single-measurement tuple exists
 when its measurement may be a false alarm or every other sensor may miss.
 """
@@ -29,7 +29,7 @@ from typing import Mapping, Sequence
 import numpy as np
 from numpy.typing import ArrayLike
 
-from ..costs.sd_builder import Scan, tuple_costs, tuple_geometry
+from .costs.sd_builder import Scan, tuple_costs, tuple_geometry
 from ..errors import InvalidProblemError
 from ..problem import AssignmentProblem
 
@@ -182,14 +182,14 @@ def build_gated_problem(scan: Scan, method: str = "pattipati", *,
                         name: str = "scan") -> AssignmentProblem:
     """The S-D problem of ``scan`` over the pairwise-gated tuples only.
 
-    The costs are those of :func:`assocopt.costs.sd_builder.build_problem` (the same
+    The costs are those of :func:`assocopt.tracking.costs.sd_builder.build_problem` (the same
     ``method``, ``localiser``, ``covariance`` and ``normalisation``); only the set of
     candidates differs.  ``name`` names the problem.
 
     Examples
     --------
     >>> from assocopt import solve
-    >>> from assocopt.scenarios.lu2013 import Lu2013
+    >>> from assocopt.tracking.scenarios.lu2013 import Lu2013
     >>> scan, truth = Lu2013(n_targets=4, d=2.0).simulate(np.random.default_rng(0))
     >>> p = build_gated_problem(scan, name="scan-0")
     >>> p.n_candidates < 4 ** 3, p.name

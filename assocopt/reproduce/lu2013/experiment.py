@@ -132,7 +132,7 @@ def _problems(scan, costs) -> dict[str, AssignmentProblem]:
             arr.setflags(write=False)
             out[m] = replace(base, costs=arr, name=f"lu2013-{m}")
         else:
-            out[m] = build_problem(scan, m, costs=c)
+            out[m] = build_problem(scan, m, costs=c, name=f"lu2013-{m}")
             if base is None and finite:
                 base = out[m]
     return out

@@ -45,7 +45,8 @@ def measurement_constant(R: np.ndarray, pd: np.ndarray, normalisation: str = "pr
                          clutter_density: np.ndarray | None = None) -> np.ndarray:
     """Constant of one real measurement: ``ln(norm(R) / P_D)`` (see module docstring).
 
-    ``R`` has shape ``(..., 2, 2)``; ``pd`` and ``clutter_density`` broadcast against
+    ``R`` has shape ``(..., 2, 2)`` (or ``(..., 1, 1)`` for azimuth only, where the
+    printed and the Gaussian normalisation coincide); ``pd`` and ``clutter_density`` broadcast against
     ``R.shape[:-2]``.
 
     >>> c = measurement_constant(np.eye(2) * 1.5e-3 ** 2, np.array(1.0))
@@ -55,14 +56,15 @@ def measurement_constant(R: np.ndarray, pd: np.ndarray, normalisation: str = "pr
     if normalisation not in NORMALISATIONS:
         raise InvalidProblemError(
             f"normalisation must be one of {NORMALISATIONS}, got {normalisation!r}")
-    det = R[..., 0, 0] * R[..., 1, 1] - R[..., 0, 1] * R[..., 1, 0]
+    w = R.shape[-1]                         # angles per measurement: 2, or 1 (azimuth)
+    det = R[..., 0, 0] if w == 1 else R[..., 0, 0] * R[..., 1, 1] - R[..., 0, 1] * R[..., 1, 0]
     if normalisation == "none":
         return np.zeros_like(det)
     if normalisation == "printed":
         return np.log(np.sqrt(2.0 * np.pi * det) / pd)
     beta = np.ones_like(det) if clutter_density is None else np.asarray(clutter_density, float)
     beta = np.where(beta > 0, beta, 1.0)
-    return np.log(2.0 * np.pi * np.sqrt(det) * beta / pd)
+    return np.log(np.sqrt((2.0 * np.pi) ** w * det) * beta / pd)
 
 
 def dummy_constant(pd: np.ndarray, normalisation: str = "printed") -> np.ndarray:

@@ -56,17 +56,21 @@ PRINTED_COSTS = ("pattipati", "kld-printed", "skld-printed")
 
 @dataclass(frozen=True)
 class Scan:
-    """One scan of N angle-only sensors.
+    """One scan of N angle-only sensors: azimuth-elevation in space, or azimuth-only
+    in the plane (chosen by the sensors' dimension).
 
     Attributes
     ----------
-    sensors : (N, 3) positions (same length unit as the targets; km in paper 002)
-    meas : list of N arrays (n_s, 2)
-        ``[alpha, beta]`` (elevation, azimuth) of each measurement, **rad**.
-    R : list of N arrays (n_s, 2, 2)
+    sensors : (N, 3) positions, or (N, 2) for azimuth-only sensors in the plane (same
+        length unit as the targets; km in paper 002)
+    meas : list of N arrays (n_s, 2) or, in the plane, (n_s, 1)
+        ``[alpha, beta]`` (elevation, azimuth) of each measurement, or the azimuth
+        ``[beta]`` alone, **rad**.
+    R : list of N arrays (n_s, 2, 2) or (n_s, 1, 1)
         Noise covariance of each measurement, rad^2.
     pd : (N,) detection probabilities, in (0, 1].
-    clutter_density : (N,) false alarms per rad^2 of the field of view (0 = none).
+    clutter_density : (N,) false alarms per rad^2 (per rad in the plane) of the field
+        of view (0 = none).
     """
 
     sensors: np.ndarray
@@ -80,26 +84,32 @@ class Scan:
                R: Sequence[ArrayLike] | ArrayLike, pd: ArrayLike = 1.0,
                clutter_density: ArrayLike = 0.0) -> "Scan":
         """Validate and normalise.  ``R`` may be one 2x2 matrix, one per sensor
-        ``(N, 2, 2)``, or one per measurement (a list of ``(n_s, 2, 2)``).
+        ``(N, 2, 2)``, or one per measurement (a list of ``(n_s, 2, 2)``); for
+        azimuth-only sensors (``sensors`` of shape ``(N, 2)``) a variance, one per
+        sensor ``(N,)``, or a list of ``(n_s,)``.
 
         >>> s = Scan.create([[0, 0, 0], [1, 0, 0]], [[[0.1, 0.2]], [[0.1, 2.0]]],
         ...                 np.eye(2) * 1e-6)
         >>> s.sizes, s.pd.tolist()
         ((1, 1), [1.0, 1.0])
+        >>> Scan.create([[0, 0], [1, 0]], [[0.2, 0.5], [2.0]], 1e-6).sizes
+        (2, 1)
         """
         S = np.asarray(sensors, dtype=np.float64)
-        if S.ndim != 2 or S.shape[1] != 3 or len(S) < 2:
-            raise InvalidProblemError(f"sensors must have shape (N, 3), N >= 2; got {S.shape}")
-        N = len(S)
+        if S.ndim != 2 or S.shape[1] not in (2, 3) or len(S) < 2:
+            raise InvalidProblemError("sensors must have shape (N, 3) (azimuth-elevation) or "
+                                      f"(N, 2) (azimuth only), N >= 2; got {S.shape}")
+        N, width = len(S), S.shape[1] - 1           # angles per measurement
         if len(meas) != N:
             raise InvalidProblemError(f"meas must list {N} arrays (one per sensor), got {len(meas)}")
         ms = []
         for s, m in enumerate(meas):
-            a = np.asarray(m, dtype=np.float64).reshape(-1, 2) if np.size(m) else np.zeros((0, 2))
+            a = np.asarray(m, dtype=np.float64).reshape(-1, width) if np.size(m) \
+                else np.zeros((0, width))
             if not np.isfinite(a).all():
                 raise InvalidProblemError(f"measurements of sensor {s} contain NaN or inf")
             ms.append(a)
-        Rs = _per_measurement_R(R, [len(a) for a in ms])
+        Rs = _per_measurement_R(R, [len(a) for a in ms], width)
         pd_a = np.broadcast_to(np.asarray(pd, dtype=np.float64), (N,)).copy()
         if not ((pd_a > 0) & (pd_a <= 1)).all():
             raise InvalidProblemError(f"pd must lie in (0, 1], got {pd_a.tolist()}")
@@ -112,25 +122,35 @@ class Scan:
     def sizes(self) -> tuple[int, ...]:
         return tuple(len(m) for m in self.meas)
 
+    @property
+    def planar(self) -> bool:
+        """Azimuth-only sensors in the plane (else azimuth-elevation in space)."""
+        return self.sensors.shape[1] == 2
 
-def _per_measurement_R(R, counts: list[int]) -> list[np.ndarray]:
+
+def _per_measurement_R(R, counts: list[int], w: int = 2) -> list[np.ndarray]:
+    """One ``(n_s, w, w)`` covariance per measurement (``w`` angles per measurement)."""
     N = len(counts)
     if isinstance(R, (list, tuple)) and len(R) == N and all(
-            np.ndim(r) == 3 for r in R):
-        out = [np.asarray(r, dtype=np.float64) for r in R]
+            np.ndim(r) == 3 or (w == 1 and np.ndim(r) == 1) for r in R):
+        out = [np.asarray(r, dtype=np.float64).reshape(-1, w, w) for r in R]
     else:
         Ra = np.asarray(R, dtype=np.float64)
-        if Ra.shape == (2, 2):
-            Ra = np.broadcast_to(Ra, (N, 2, 2))
-        if Ra.shape != (N, 2, 2):
-            raise InvalidProblemError(
-                f"R must be (2, 2), (N, 2, 2) or a list of (n_s, 2, 2); got {Ra.shape}")
-        out = [np.broadcast_to(Ra[s], (n, 2, 2)).copy() for s, n in enumerate(counts)]
+        if w == 1 and Ra.ndim <= 1 and Ra.size in (1, N):
+            Ra = Ra.reshape(-1, 1, 1)
+        if Ra.shape in ((w, w), (1, w, w)):
+            Ra = np.broadcast_to(Ra.reshape(w, w), (N, w, w))
+        if Ra.shape != (N, w, w):
+            forms = ("a variance, (N,) or a list of (n_s,)" if w == 1 else
+                     "(2, 2), (N, 2, 2) or a list of (n_s, 2, 2)")
+            raise InvalidProblemError(f"R must be {forms}; got {Ra.shape}")
+        out = [np.broadcast_to(Ra[s], (n, w, w)).copy() for s, n in enumerate(counts)]
     for s, (r, n) in enumerate(zip(out, counts)):
-        if r.shape != (n, 2, 2):
-            raise InvalidProblemError(f"R of sensor {s} must have shape ({n}, 2, 2), got {r.shape}")
+        if r.shape != (n, w, w):
+            raise InvalidProblemError(f"R of sensor {s} must have shape ({n}, {w}, {w}), "
+                                      f"got {r.shape}")
         if n and not (np.isfinite(r).all() and (r[:, 0, 0] > 0).all()
-                      and (r[:, 0, 0] * r[:, 1, 1] - r[:, 0, 1] * r[:, 1, 0] > 0).all()):
+                      and (np.linalg.det(r) > 0).all()):
             raise InvalidProblemError(f"R of sensor {s} must be positive definite")
     return out
 
@@ -200,11 +220,14 @@ def tuple_geometry(scan: Scan, tuples: np.ndarray | None = None, *, localiser: s
     T = np.asarray(tuples, dtype=np.int64)
     K, N = T.shape
     mask = T > 0
+    w = 1 if scan.planar else 2
     # gather each tuple's measurements and covariances (index 0 = dummy -> padding)
-    meas = np.stack([np.concatenate([np.zeros((1, 2)), scan.meas[s]])[T[:, s]]
-                     for s in range(N)], axis=1)
-    R = np.stack([np.concatenate([np.eye(2)[None], scan.R[s]])[T[:, s]]
-                  for s in range(N)], axis=1)
+    meas = np.stack([np.concatenate([np.zeros((1, w)), scan.meas[s]])[T[:, s]]
+                     for s in range(N)], axis=1).reshape(K, N, w)
+    R = np.stack([np.concatenate([np.eye(w)[None], scan.R[s]])[T[:, s]]
+                  for s in range(N)], axis=1).reshape(K, N, w, w)
+    if scan.planar:
+        return _planar_geometry(scan, T, mask, meas, R, localiser, covariance)
     loc_rows = mask.sum(axis=1) >= 2
     if loc_rows.all():
         loc = localise_indexed(scan.meas, scan.R, scan.sensors, T, method=localiser,
@@ -232,6 +255,26 @@ def tuple_geometry(scan: Scan, tuples: np.ndarray | None = None, *, localiser: s
                          {"localiser": localiser, "covariance": covariance})
 
 
+def _planar_geometry(scan, T, mask, meas, R, localiser, covariance) -> TupleGeometry:
+    """:func:`tuple_geometry` for azimuth-only sensors (positions in the plane)."""
+    from ..azimuth import azimuth_pseudo_measurements, localise_azimuths
+
+    if localiser != "ls":
+        raise InvalidProblemError(f"azimuth-only sensors support localiser='ls', "
+                                  f"got {localiser!r}")
+    K, N = T.shape
+    loc = localise_azimuths([m[:, 0] for m in scan.meas], [r[:, 0, 0] for r in scan.R],
+                            scan.sensors, T, covariance=covariance)
+    pm_mean = np.zeros((K, N, 1))
+    pm_cov = np.ones((K, N, 1, 1))
+    good = np.flatnonzero(loc.valid)
+    if len(good):
+        pm = azimuth_pseudo_measurements(loc.x[good], loc.P[good], scan.sensors)
+        pm_mean[good], pm_cov[good] = pm.mean, pm.cov
+    return TupleGeometry(T, mask, meas, R, loc.x, loc.P, loc.valid, pm_mean, pm_cov,
+                         {"localiser": localiser, "covariance": covariance})
+
+
 @dataclass(frozen=True)
 class SDCosts:
     """Costs of every candidate tuple for one method.
@@ -254,6 +297,14 @@ def _components(g: TupleGeometry):
     if cached is not None:
         return cached
     delta = g.pm_mean - g.meas
+    if delta.shape[-1] == 1:
+        # azimuth only: a neutral elevation slot (zero difference, unit variances, no
+        # correlation) contributes exactly 0 to every data term below
+        zero, one = np.zeros(delta.shape[:-1]), np.ones(delta.shape[:-1])
+        comp = dict(da=zero, db=wrap_angle(delta[..., 0]), ra=one, rb=g.R[..., 0, 0],
+                    rab=zero, ta=one, tb=g.pm_cov[..., 0, 0], tab=zero)
+        g.cache["components"] = comp
+        return comp
     da = delta[..., 0]
     db = wrap_angle(delta[..., 1])
     comp = dict(da=da, db=db, ra=g.R[..., 0, 0], rb=g.R[..., 1, 1], rab=g.R[..., 0, 1],
@@ -343,13 +394,14 @@ def build_costs(scan: Scan, methods: Sequence[str] = tuple(COSTS), *, localiser:
 
 
 def build_problem(scan: Scan, method: str = "pattipati", *, costs: SDCosts | None = None,
-                  **options) -> AssignmentProblem:
+                  name: str | None = None, **options) -> AssignmentProblem:
     """The S-D :class:`AssignmentProblem` of ``scan`` with the named cost.
 
     Forbidden tuples (``+inf``) are dropped here, so the problem's candidates are the
-    finite entries of ``costs`` in the same order.
+    finite entries of ``costs`` in the same order.  ``name`` names the problem
+    (default ``"bearing-METHOD"``).
     """
     c = costs if costs is not None else build_costs(scan, [method], **options)[method]
     keep = np.isfinite(c.total)
     return AssignmentProblem.sparse(scan.sizes, c.tuples[keep], c.total[keep],
-                                    name=f"lu2013-{c.method}")
+                                    name=name or f"bearing-{c.method}")
