@@ -1,0 +1,156 @@
+"""assocopt inside Stone Soup: data associators solved by any assocopt back end.
+
+Install with ``pip install assocopt[stonesoup]``.  :class:`AssocoptGNN` is a drop-in
+replacement for Stone Soup's :class:`~stonesoup.dataassociator.neighbour.GNNWith2DAssignment`:
+it takes the same hypothesiser, turns its hypotheses into a sparse 2-D
+:class:`~assocopt.problem.AssignmentProblem` and returns a
+:class:`~stonesoup.types.hypothesis.JointHypothesis` (a mapping track -> hypothesis)
+from the optimum.
+
+The problem (rows = tracks, columns = detections):
+
+* a detection hypothesis of track ``i`` and detection ``j`` is candidate ``(i, j)``
+  with cost its distance (:class:`~stonesoup.types.hypothesis.SingleDistanceHypothesis`)
+  or minus its probability (``probability_score="linear"``, the sum of probabilities
+  that ``GNNWith2DAssignment`` maximises) or minus its log-probability
+  (``probability_score="log"``: the most probable joint association);
+* the missed-detection hypothesis of track ``i`` is its miss candidate ``(i, 0)``
+  (a track without one must be assigned a detection);
+* a detection left unassigned costs 0.
+
+Tracks without any hypothesis are left out of the association, as in Stone Soup.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+try:
+    from stonesoup.base import Property
+    from stonesoup.dataassociator.base import DataAssociator
+    from stonesoup.hypothesiser import Hypothesiser
+    from stonesoup.types.hypothesis import (JointHypothesis, SingleDistanceHypothesis,
+                                            SingleProbabilityHypothesis)
+except ImportError as exc:  # pragma: no cover - exercised in a subprocess-free test
+    raise ImportError("assocopt.tracking.stonesoup needs Stone Soup: "
+                      "pip install assocopt[stonesoup]") from exc
+
+from ..api import solve
+from ..problem import AssignmentProblem
+from ..solution import Status
+
+__all__ = ["AssocoptGNN", "hypotheses_problem"]
+
+#: Accepted values of ``probability_score``.
+PROBABILITY_SCORES = ("linear", "log")
+
+
+def hypotheses_problem(hypotheses, probability_score: str = "linear"):
+    """The 2-D problem of a hypothesiser's output (module docstring).
+
+    Parameters
+    ----------
+    hypotheses : mapping track -> iterable of SingleHypothesis
+        What ``DataAssociator.generate_hypotheses`` returns.
+    probability_score : "linear" or "log"
+
+    Returns
+    -------
+    problem : AssignmentProblem
+    tracks : list of tracks (row ``i + 1`` of the problem is ``tracks[i]``)
+    table : dict mapping a candidate tuple ``(i, j)`` to its hypothesis
+    """
+    if probability_score not in PROBABILITY_SCORES:
+        raise ValueError(f"probability_score must be one of {PROBABILITY_SCORES}, "
+                         f"got {probability_score!r}")
+    tracks = [t for t, hyps in hypotheses.items() if hyps]
+    det_index: dict = {}
+    table: dict[tuple[int, int], object] = {}
+    rows, cols, costs = [], [], []
+    kinds = set()
+    for i, track in enumerate(tracks, start=1):
+        for hyp in hypotheses[track]:
+            if isinstance(hyp, SingleProbabilityHypothesis):
+                kinds.add("probability")
+                p = hyp.probability
+                log_p = float(getattr(p, "log_value", math.log(float(p)) if float(p) > 0
+                                      else -math.inf))
+                cost = -float(p) if probability_score == "linear" else -log_p
+            elif isinstance(hyp, SingleDistanceHypothesis):
+                kinds.add("distance")
+                cost = float(hyp.distance)
+            else:
+                raise TypeError(f"hypothesis of type {type(hyp).__name__} has neither a "
+                                "distance nor a probability")
+            j = det_index.setdefault(hyp.measurement, len(det_index) + 1) if hyp else 0
+            if (i, j) in table:
+                raise ValueError(f"track {i - 1} has two hypotheses for "
+                                 f"{'a missed detection' if j == 0 else 'one detection'}")
+            table[(i, j)] = hyp
+            rows.append(i)
+            cols.append(j)
+            costs.append(cost)
+    if len(kinds) > 1:
+        raise RuntimeError("2d assignment does not support mixed hypothesis types")
+    free = np.arange(1, len(det_index) + 1)
+    tuples = np.concatenate([np.stack([np.asarray(rows, np.int64), np.asarray(cols, np.int64)],
+                                      axis=1).reshape(-1, 2),
+                             np.stack([np.zeros_like(free), free], axis=1)])
+    c = np.concatenate([np.asarray(costs, np.float64), np.zeros(len(free))])
+    problem = AssignmentProblem.sparse((len(tracks), len(det_index)), tuples, c,
+                                       name="stonesoup-hypotheses")
+    return problem, tracks, table
+
+
+def _joint(tuples: np.ndarray, tracks: list, table: dict) -> JointHypothesis:
+    chosen = {tracks[i - 1]: table[(i, j)] for i, j in tuples.tolist() if i > 0}
+    return JointHypothesis(chosen)
+
+
+class AssocoptGNN(DataAssociator):
+    """Global nearest neighbour association solved by an assocopt back end.
+
+    Builds the sparse 2-D assignment problem of the hypothesiser's hypotheses
+    (distance or probability hypotheses, missed-detection hypotheses included; see
+    :mod:`assocopt.tracking.stonesoup`) and returns the optimal
+    :class:`~.JointHypothesis`.  With distance hypotheses it gives the associations
+    of :class:`~.GNNWith2DAssignment` (whenever the optimum is unique).
+    """
+
+    hypothesiser: Hypothesiser = Property(
+        doc="Generate a set of hypotheses for each prediction-detection pair")
+    solver: str = Property(
+        default="auto",
+        doc="assocopt back end that solves the problem (``assocopt solvers`` lists "
+            "them); ``auto`` picks the 2-D fast path")
+    solver_options: dict = Property(
+        default=None,
+        doc="Keyword options passed to :func:`assocopt.solve` (e.g. ``time_limit``)")
+    probability_score: str = Property(
+        default="linear",
+        doc="How probability hypotheses become costs: ``linear`` maximises the sum of "
+            "probabilities as GNNWith2DAssignment does; ``log`` their product")
+
+    def associate(self, tracks, detections, timestamp, **kwargs):
+        """Associate ``detections`` with ``tracks``.
+
+        Returns
+        -------
+        : :class:`~.JointHypothesis`
+            Mapping of each track that has hypotheses to its chosen hypothesis
+        """
+        hypotheses = self.generate_hypotheses(tracks, detections, timestamp, **kwargs)
+        return self.associate_hypotheses(hypotheses)
+
+    def associate_hypotheses(self, hypotheses) -> JointHypothesis:
+        """The optimal joint hypothesis of already generated ``hypotheses``."""
+        problem, tracks, table = hypotheses_problem(hypotheses, self.probability_score)
+        sol = solve(problem, self.solver, **(self.solver_options or {}))
+        if sol.status is Status.INFEASIBLE:
+            raise RuntimeError("Assignment was not feasible")
+        if not sol.has_solution:
+            raise RuntimeError(f"assocopt back end {sol.solver!r} found no association: "
+                               f"{sol.status.value} {sol.message}".strip())
+        return _joint(sol.tuples, tracks, table)

@@ -1,0 +1,139 @@
+"""assocopt inside Stone Soup: the same associations and tracks as GNNWith2DAssignment."""
+
+from __future__ import annotations
+
+import sys
+from datetime import datetime, timedelta
+
+import numpy as np
+import pytest
+
+pytest.importorskip("stonesoup", reason="Stone Soup not installed (pip install assocopt[stonesoup])")
+
+from stonesoup.dataassociator.neighbour import GNNWith2DAssignment  # noqa: E402
+from stonesoup.hypothesiser.distance import DistanceHypothesiser  # noqa: E402
+from stonesoup.hypothesiser.probability import PDAHypothesiser  # noqa: E402
+from stonesoup.measures import Mahalanobis  # noqa: E402
+from stonesoup.models.measurement.linear import LinearGaussian  # noqa: E402
+from stonesoup.models.transition.linear import (  # noqa: E402
+    CombinedLinearGaussianTransitionModel, ConstantVelocity)
+from stonesoup.predictor.kalman import KalmanPredictor  # noqa: E402
+from stonesoup.types.detection import Clutter, Detection  # noqa: E402
+from stonesoup.types.state import GaussianState  # noqa: E402
+from stonesoup.types.track import Track  # noqa: E402
+from stonesoup.updater.kalman import KalmanUpdater  # noqa: E402
+
+from assocopt.tracking.simulate import CVScenario  # noqa: E402
+from assocopt.tracking.stonesoup import AssocoptGNN, hypotheses_problem  # noqa: E402
+
+START = datetime(2026, 1, 1)
+
+
+def _scene(sc: CVScenario, seed: int):
+    out = sc.simulate(np.random.default_rng(seed))
+    transition = CombinedLinearGaussianTransitionModel(
+        [ConstantVelocity(sc.q), ConstantVelocity(sc.q)])
+    mm = LinearGaussian(ndim_state=4, mapping=(0, 2), noise_covar=sc.R)
+    scans = []
+    for k, (z, lab) in enumerate(zip(out.meas, out.labels), start=1):
+        t = START + timedelta(seconds=k * sc.dt)
+        scans.append((t, {(Clutter if lab[m] < 0 else Detection)(
+            z[m][:, None], timestamp=t, measurement_model=mm) for m in range(len(z))}))
+    priors = [GaussianState(x[:, None], np.diag([1.0, 0.5, 1.0, 0.5]), timestamp=START)
+              for x in out.truth[0]]
+    predictor = KalmanPredictor(transition)
+    updater = KalmanUpdater(mm)
+    return out, scans, priors, predictor, updater
+
+
+def _run(associator, updater, priors, scans):
+    """A tutorial-style GNN loop; returns the tracks and each step's associations."""
+    tracks = [Track([p]) for p in priors]
+    history = []
+    for t, dets in scans:
+        assoc = associator.associate(set(tracks), dets, t)
+        history.append({tracks.index(tr): (h.measurement if h else None)
+                        for tr, h in assoc.items()})
+        for tr, h in assoc.items():
+            tr.append(updater.update(h) if h else h.prediction)
+    return tracks, history
+
+
+@pytest.mark.parametrize("solver", ["auto", "highs"])
+def test_same_associations_and_identical_tracks_as_gnn_with_2d_assignment(solver):
+    sc = CVScenario(n_targets=5, n_steps=25, clutter_rate=4.0, pd=0.9)
+    out, scans, priors, predictor, updater = _scene(sc, seed=3)
+    hyp = DistanceHypothesiser(predictor, updater, measure=Mahalanobis(), missed_distance=3)
+    ours_tracks, ours = _run(AssocoptGNN(hyp, solver=solver), updater, priors, scans)
+    ref_tracks, ref = _run(GNNWith2DAssignment(hyp), updater, priors, scans)
+    assert ours == ref                                          # at every step
+    assert sum(m is not None for step in ref for m in step.values()) > 80
+    assert sum(m is None for step in ref for m in step.values()) > 5   # misses happen
+    for a, b in zip(ours_tracks, ref_tracks):
+        assert len(a) == len(b) == sc.n_steps + 1
+        for sa, sb in zip(a.states, b.states):
+            assert np.array_equal(sa.state_vector, sb.state_vector)
+            assert np.array_equal(sa.covar, sb.covar)
+
+
+def test_probability_hypotheses_match_gnn_with_2d_assignment():
+    sc = CVScenario(n_targets=4, n_steps=10, clutter_rate=3.0, pd=0.9)
+    out, scans, priors, predictor, updater = _scene(sc, seed=8)
+    hyp = PDAHypothesiser(predictor, updater, clutter_spatial_density=sc.clutter_density,
+                          prob_detect=0.9)
+    _, ours = _run(AssocoptGNN(hyp), updater, priors, scans)
+    _, ref = _run(GNNWith2DAssignment(hyp), updater, priors, scans)
+    assert ours == ref
+
+
+def test_log_score_maximises_the_product_of_probabilities():
+    sc = CVScenario(n_targets=4, n_steps=1, clutter_rate=3.0, pd=0.9)
+    out, scans, priors, predictor, updater = _scene(sc, seed=2)
+    hyp = PDAHypothesiser(predictor, updater, clutter_spatial_density=sc.clutter_density,
+                          prob_detect=0.9)
+    tracks = {Track([p]) for p in priors}
+    t, dets = scans[0]
+    hypotheses = {tr: hyp.hypothesise(tr, dets, t) for tr in tracks}
+    best = AssocoptGNN(hyp, probability_score="log").associate_hypotheses(hypotheses)
+    from stonesoup.dataassociator.neighbour import GlobalNearestNeighbour
+    exhaustive = max(GlobalNearestNeighbour.enumerate_joint_hypotheses(hypotheses))
+    assert {tr: h.measurement for tr, h in best.items()} == \
+        {tr: h.measurement for tr, h in exhaustive.items()}
+
+
+def test_problem_from_hypotheses_has_the_miss_candidates():
+    sc = CVScenario(n_targets=3, n_steps=1, clutter_rate=2.0)
+    out, scans, priors, predictor, updater = _scene(sc, seed=1)
+    hyp = DistanceHypothesiser(predictor, updater, measure=Mahalanobis(), missed_distance=3)
+    t, dets = scans[0]
+    hypotheses = {Track([p]): hyp.hypothesise(Track([p]), dets, t) for p in priors}
+    p, tracks, table = hypotheses_problem(hypotheses)
+    rm, cm = p.miss_costs()
+    np.testing.assert_array_equal(rm, 3.0)
+    np.testing.assert_array_equal(cm, 0.0)
+    n_hyp = sum(len(h) for h in hypotheses.values())
+    assert p.n_candidates == n_hyp + p.sizes[1] and len(table) == n_hyp
+    for (i, j), h in table.items():
+        assert (j == 0) == (not h)
+
+
+def test_missing_stonesoup_names_the_extra():
+    import subprocess
+
+    code = ("import sys; sys.modules['stonesoup'] = None\n"
+            "try:\n    import assocopt.tracking.stonesoup\n"
+            "except ImportError as exc:\n    print(exc)")
+    res = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
+                         check=True)
+    assert "pip install assocopt[stonesoup]" in res.stdout
+
+
+def test_importing_tracking_does_not_import_stonesoup():
+    import subprocess
+
+    code = ("import sys, assocopt.tracking, assocopt.tracking.gating, "
+            "assocopt.tracking.costs.kinematic, assocopt.tracking.sd_gating; "
+            "print('stonesoup' in sys.modules)")
+    res = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
+                         check=True)
+    assert res.stdout.strip() == "False"
