@@ -137,3 +137,16 @@ def test_importing_tracking_does_not_import_stonesoup():
     res = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
                          check=True)
     assert res.stdout.strip() == "False"
+
+
+def test_guide_figure_script_draws_both_loops(tmp_path):
+    import importlib.util
+    from pathlib import Path
+
+    path = Path(__file__).resolve().parents[1] / "docs" / "tracking_figure.py"
+    spec = importlib.util.spec_from_file_location("tracking_figure", path)
+    mod = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(mod)
+    assert len(mod.section_blocks()) == 2
+    out = mod.main(["--out", str(tmp_path / "fig.png")])
+    assert out.stat().st_size > 10_000
