@@ -181,3 +181,15 @@ def test_empty_scans():
     p = kin.build_problem(np.zeros((2, 2)), np.eye(2), np.zeros((0, 2)))
     assert p.sizes == (2, 0) and solve(p).objective == pytest.approx(
         2 * -math.log(1 - 0.9 * 0.99))
+
+
+def test_the_core_never_imports_tracking():
+    import subprocess
+    import sys
+
+    code = ("import sys, assocopt, assocopt.api, assocopt.problem, assocopt.solvers, "
+            "assocopt.io, assocopt.cli; "
+            "print(any(m.startswith('assocopt.tracking') for m in sys.modules))")
+    res = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
+                         check=True)
+    assert res.stdout.strip() == "False"

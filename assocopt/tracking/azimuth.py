@@ -28,7 +28,8 @@ from numpy.typing import ArrayLike
 from ..errors import InvalidProblemError
 from .localisation import COVARIANCES, RCOND_MIN, Localisation, PseudoMeasurements
 
-__all__ = ["azimuths", "localise_azimuths", "azimuth_pseudo_measurements"]
+__all__ = ["azimuths", "localise_azimuths", "azimuth_pseudo_measurements",
+           "planar_tuple_geometry"]
 
 
 def _check_sensors(sensors: ArrayLike) -> np.ndarray:
@@ -146,3 +147,26 @@ def azimuth_pseudo_measurements(x: ArrayLike, P: ArrayLike, sensors: ArrayLike
     var = np.einsum("kni,kij,knj->kn", g, Pm, g)
     return PseudoMeasurements(mean=np.arctan2(d[..., 1], d[..., 0])[..., None],
                               cov=var[..., None, None], jac=g[:, :, None, :])
+
+
+def planar_tuple_geometry(scan, tuples: np.ndarray, localiser: str = "ls",
+                          covariance: str = "residual") -> tuple[np.ndarray, ...]:
+    """Positions, covariances, validity and pseudo-measurements of the tuples of an
+    azimuth-only :class:`~assocopt.costs.sd_builder.Scan` (for its ``tuple_geometry``).
+
+    Returns ``(x, P, valid, pm_mean, pm_cov)``; pseudo-measurements of tuples that
+    cannot be localised are 0 with unit variance (their costs are forbidden anyway).
+    """
+    if localiser != "ls":
+        raise InvalidProblemError(f"azimuth-only sensors support localiser='ls', "
+                                  f"got {localiser!r}")
+    K, N = tuples.shape
+    loc = localise_azimuths([m[:, 0] for m in scan.meas], [r[:, 0, 0] for r in scan.R],
+                            scan.sensors, tuples, covariance=covariance)
+    pm_mean = np.zeros((K, N, 1))
+    pm_cov = np.ones((K, N, 1, 1))
+    good = np.flatnonzero(loc.valid)
+    if len(good):
+        pm = azimuth_pseudo_measurements(loc.x[good], loc.P[good], scan.sensors)
+        pm_mean[good], pm_cov[good] = pm.mean, pm.cov
+    return loc.x, loc.P, loc.valid, pm_mean, pm_cov

@@ -227,7 +227,10 @@ def tuple_geometry(scan: Scan, tuples: np.ndarray | None = None, *, localiser: s
     R = np.stack([np.concatenate([np.eye(w)[None], scan.R[s]])[T[:, s]]
                   for s in range(N)], axis=1).reshape(K, N, w, w)
     if scan.planar:
-        return _planar_geometry(scan, T, mask, meas, R, localiser, covariance)
+        from ..azimuth import planar_tuple_geometry
+        x, P, valid, pm_mean, pm_cov = planar_tuple_geometry(scan, T, localiser, covariance)
+        return TupleGeometry(T, mask, meas, R, x, P, valid, pm_mean, pm_cov,
+                             {"localiser": localiser, "covariance": covariance})
     loc_rows = mask.sum(axis=1) >= 2
     if loc_rows.all():
         loc = localise_indexed(scan.meas, scan.R, scan.sensors, T, method=localiser,
@@ -252,26 +255,6 @@ def tuple_geometry(scan: Scan, tuples: np.ndarray | None = None, *, localiser: s
         pm = pseudo_measurements(x[good], P[good], scan.sensors)
         pm_mean[good], pm_cov[good] = pm.mean, pm.cov
     return TupleGeometry(T, mask, meas, R, x, P, valid, pm_mean, pm_cov,
-                         {"localiser": localiser, "covariance": covariance})
-
-
-def _planar_geometry(scan, T, mask, meas, R, localiser, covariance) -> TupleGeometry:
-    """:func:`tuple_geometry` for azimuth-only sensors (positions in the plane)."""
-    from ..azimuth import azimuth_pseudo_measurements, localise_azimuths
-
-    if localiser != "ls":
-        raise InvalidProblemError(f"azimuth-only sensors support localiser='ls', "
-                                  f"got {localiser!r}")
-    K, N = T.shape
-    loc = localise_azimuths([m[:, 0] for m in scan.meas], [r[:, 0, 0] for r in scan.R],
-                            scan.sensors, T, covariance=covariance)
-    pm_mean = np.zeros((K, N, 1))
-    pm_cov = np.ones((K, N, 1, 1))
-    good = np.flatnonzero(loc.valid)
-    if len(good):
-        pm = azimuth_pseudo_measurements(loc.x[good], loc.P[good], scan.sensors)
-        pm_mean[good], pm_cov[good] = pm.mean, pm.cov
-    return TupleGeometry(T, mask, meas, R, loc.x, loc.P, loc.valid, pm_mean, pm_cov,
                          {"localiser": localiser, "covariance": covariance})
 
 
