@@ -152,7 +152,7 @@ def azimuth_pseudo_measurements(x: ArrayLike, P: ArrayLike, sensors: ArrayLike
 def planar_tuple_geometry(scan, tuples: np.ndarray, localiser: str = "ls",
                           covariance: str = "residual") -> tuple[np.ndarray, ...]:
     """Positions, covariances, validity and pseudo-measurements of the tuples of an
-    azimuth-only :class:`~assocopt.costs.sd_builder.Scan` (for its ``tuple_geometry``).
+    azimuth-only :class:`~assocopt.tracking.costs.sd_builder.Scan` (for its ``tuple_geometry``).
 
     Returns ``(x, P, valid, pm_mean, pm_cov)``; pseudo-measurements of tuples that
     cannot be localised are 0 with unit variance (their costs are forbidden anyway).
