@@ -24,7 +24,8 @@ from stonesoup.types.track import Track  # noqa: E402
 from stonesoup.updater.kalman import KalmanUpdater  # noqa: E402
 
 from assocopt.tracking.simulate import CVScenario  # noqa: E402
-from assocopt.tracking.stonesoup import AssocoptGNN, hypotheses_problem  # noqa: E402
+from assocopt.tracking.stonesoup import (AssocoptGNN, AssocoptKBest,  # noqa: E402
+                                         hypotheses_problem)
 
 START = datetime(2026, 1, 1)
 
@@ -137,6 +138,29 @@ def test_importing_tracking_does_not_import_stonesoup():
     res = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
                          check=True)
     assert res.stdout.strip() == "False"
+
+
+@pytest.mark.parametrize("k", [1, 4, 50])
+def test_k_best_joint_hypotheses_equal_stone_soups_enumeration(k):
+    from stonesoup.dataassociator.neighbour import GlobalNearestNeighbour
+
+    sc = CVScenario(n_targets=3, n_steps=1, clutter_rate=2.0, region=((-6.0, 6.0),) * 2)
+    out, scans, priors, predictor, updater = _scene(sc, seed=7)
+    hyp = DistanceHypothesiser(predictor, updater, measure=Mahalanobis(), missed_distance=4)
+    tracks = {Track([p]) for p in priors}
+    t, dets = scans[0]
+    hypotheses = {tr: hyp.hypothesise(tr, dets, t) for tr in tracks}
+    ranked = AssocoptKBest(hyp, k=k).associate_hypotheses(hypotheses)
+    every = sorted(float(j.distance) for j in
+                   GlobalNearestNeighbour.enumerate_joint_hypotheses(hypotheses))
+    assert 8 < len(every) < 50                       # the scene has real alternatives
+    assert [float(j.distance) for j in ranked] == pytest.approx(every[:k])
+    keys = [frozenset((tr, h.measurement) for tr, h in j.items()) for j in ranked]
+    assert len(set(keys)) == len(keys)                    # distinct joint hypotheses
+    best = AssocoptGNN(hyp).associate_hypotheses(hypotheses)
+    assert keys[0] == frozenset((tr, h.measurement) for tr, h in best.items())
+    with pytest.raises(ValueError, match="positive integer"):
+        AssocoptKBest(hyp, k=0).associate_hypotheses(hypotheses)
 
 
 def test_guide_figure_script_draws_both_loops(tmp_path):

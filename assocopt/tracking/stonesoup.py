@@ -5,7 +5,8 @@ replacement for Stone Soup's :class:`~stonesoup.dataassociator.neighbour.GNNWith
 it takes the same hypothesiser, turns its hypotheses into a sparse 2-D
 :class:`~assocopt.problem.AssignmentProblem` and returns a
 :class:`~stonesoup.types.hypothesis.JointHypothesis` (a mapping track -> hypothesis)
-from the optimum.
+from the optimum.  :class:`AssocoptKBest` returns the ``k`` best joint hypotheses
+(Murty's ranking, :func:`assocopt.kbest`).
 
 The problem (rows = tracks, columns = detections):
 
@@ -41,7 +42,7 @@ from ..api import solve
 from ..problem import AssignmentProblem
 from ..solution import Status
 
-__all__ = ["AssocoptGNN", "hypotheses_problem"]
+__all__ = ["AssocoptGNN", "AssocoptKBest", "hypotheses_problem"]
 
 #: Accepted values of ``probability_score``.
 PROBABILITY_SCORES = ("linear", "log")
@@ -154,3 +155,36 @@ class AssocoptGNN(DataAssociator):
             raise RuntimeError(f"assocopt back end {sol.solver!r} found no association: "
                                f"{sol.status.value} {sol.message}".strip())
         return _joint(sol.tuples, tracks, table)
+
+
+class AssocoptKBest(AssocoptGNN):
+    """The ``k`` best joint hypotheses, by Murty's ranking (:func:`assocopt.kbest`).
+
+    ``associate`` returns a list of up to ``k`` :class:`~.JointHypothesis`, best
+    first (all of them when fewer feasible associations exist), for
+    multiple-hypothesis trackers and k-best approximations of JPDA.  The first is
+    the one :class:`AssocoptGNN` returns.
+    """
+
+    k: int = Property(default=5, doc="Number of joint hypotheses to return")
+
+    def associate(self, tracks, detections, timestamp, **kwargs):
+        """The ``k`` best joint hypotheses, best first.
+
+        Returns
+        -------
+        : list of :class:`~.JointHypothesis`
+        """
+        hypotheses = self.generate_hypotheses(tracks, detections, timestamp, **kwargs)
+        return self.associate_hypotheses(hypotheses)
+
+    def associate_hypotheses(self, hypotheses) -> list:
+        """The ``k`` best joint hypotheses of already generated ``hypotheses``."""
+        from .. import kbest
+
+        if isinstance(self.k, bool) or int(self.k) != self.k or self.k < 1:
+            raise ValueError(f"k must be a positive integer, got {self.k!r}")
+        problem, tracks, table = hypotheses_problem(hypotheses, self.probability_score)
+        ranked = kbest(problem, int(self.k), solver=self.solver,
+                       **(self.solver_options or {}))
+        return [_joint(s.tuples, tracks, table) for s in ranked]
