@@ -5,7 +5,9 @@
   optimisation model solved by any back end;
 * :mod:`.did` -- paper 003's distributed inference decision (DID), both stages;
 * :mod:`.nearest` -- report-to-track GNN (a 2-D assignment through ``solve``) and
-  nearest neighbour.
+  nearest neighbour;
+* :mod:`.max_degree` -- paper 001's maximum-degree rule, association-quality counter,
+  its 2-D assignment counterpart and the weighted chi-square baseline.
 """
 
 from .md2da import MD2DAResult, gate_threshold, md_2da, md_2da_problem
