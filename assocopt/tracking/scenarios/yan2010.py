@@ -1,0 +1,208 @@
+"""Paper 001's scenario: emitters in the plane seen by two three-baseline TDOA systems,
+each tracking every emitter locally and measuring its frequency, PW and PRI.
+
+The paper's values (:data:`PAPER`): main stations at (100 km, 0) and (-100 km, 0);
+baselines 25 km and 30 km, 120 degrees apart; TDOA RMS error 30 ns; frequency RMS error
+2 and 3 MHz, PW 25 and 30 ns, PRI 45 and 50 ns; initial positions uniform in
+[-100, 100] km per axis, speed uniform in 100-1000 m/s, heading uniform in [0, 2 pi);
+manoeuvres and velocity process noise; fixed frequency, PW and PRI; local tracking by
+an extended Kalman filter.  Everything else is ours (:data:`OURS`, the fields of
+:class:`Yan2010` not in :data:`PAPER`), recorded with every result:
+
+* sampling period 1 s, time 0..80 s; tracks start at the second scan (two-point
+  initialisation from the first two fixes);
+* the baselines point at 90, 210 and 330 degrees;
+* velocity process noise: a random walk of intensity ``q_true`` (m^2/s^3);
+* manoeuvres: every emitter makes one coordinated turn, starting at a time uniform
+  in ``turn_start``, lasting ``turn_duration``, with lateral acceleration uniform in
+  ``turn_accel`` (sign random);
+* emitter parameters uniform in ``freq_range`` (MHz), ``pw_range`` and ``pri_range``
+  (microseconds), measured afresh at every scan with the paper's RMS errors;
+* trackers (``tracker``): ``"ekf"`` -- the paper's EKF on the three range differences;
+  ``"kf-fix"`` -- a linear Kalman filter on the linear TDOA fixes with their
+  covariances; both with the nearly-constant-velocity model of intensity ``q_filter``;
+* node 2 numbers its tracks in a random order (the association is not given away).
+"""
+
+from __future__ import annotations
+
+from dataclasses import asdict, dataclass, fields
+from typing import NamedTuple
+
+import numpy as np
+
+from ..filters import cv_model, predict, two_point_init, update
+from ..localisation.tdoa import C_LIGHT, TdoaSystem
+
+__all__ = ["PAPER", "OURS", "TRACKERS", "Yan2010", "Yan2010Run"]
+
+TRACKERS = ("ekf", "kf-fix")
+
+#: The paper's parameters (metres, seconds, MHz, microseconds).
+PAPER = {
+    "main_stations_m": [[100e3, 0.0], [-100e3, 0.0]],
+    "baselines_m": [25e3, 30e3],
+    "baseline_angle_deg": 120.0,
+    "tdoa_sigma_s": [30e-9, 30e-9],
+    "freq_sigma_mhz": [2.0, 3.0],
+    "pw_sigma_us": [0.025, 0.030],
+    "pri_sigma_us": [0.045, 0.050],
+    "initial_position_m": [-100e3, 100e3],
+    "speed_range_mps": [100.0, 1000.0],
+    "heading_range_rad": [0.0, 2 * np.pi],
+    "local_tracker": "extended Kalman filter",
+    "table1_time_s": 80.0,
+}
+
+
+class Yan2010Run(NamedTuple):
+    """One simulated run: truth and both nodes' track outputs at every reported scan.
+
+    ``times`` ``(K,)``; ``truth`` ``(K, N, 4)``; ``x[n]`` ``(K, N, 4)`` and ``P[n]``
+    ``(K, N, 4, 4)`` node ``n``'s track estimates; ``features[n]`` ``(K, N, 3)``
+    (frequency MHz, PW us, PRI us) as measured at each scan; ``partner[i]`` = node-2
+    track of the emitter of node-1 track ``i`` (node-1 track ``i`` is emitter ``i``);
+    ``partners[n]`` the same for every node (``partners[0]`` is the identity).
+    """
+
+    times: np.ndarray
+    truth: np.ndarray
+    x: tuple[np.ndarray, ...]
+    P: tuple[np.ndarray, ...]
+    features: tuple[np.ndarray, ...]
+    partner: np.ndarray
+    partners: tuple[np.ndarray, ...]
+
+
+@dataclass(frozen=True)
+class Yan2010:
+    """The scenario; parameters the paper does not give are ours (module docstring)."""
+
+    n_targets: int = 60
+    duration: float = 80.0
+    period: float = 1.0
+    tracker: str = "ekf"
+    q_true: float = 1.0
+    q_filter: float = 20.0
+    turn_start: tuple[float, float] = (10.0, 60.0)
+    turn_duration: tuple[float, float] = (5.0, 20.0)
+    turn_accel: tuple[float, float] = (2.0, 20.0)
+    freq_range: tuple[float, float] = (9000.0, 9400.0)
+    pw_range: tuple[float, float] = (0.5, 1.5)
+    pri_range: tuple[float, float] = (900.0, 1100.0)
+    baseline_angles_deg: tuple[float, float, float] = (90.0, 210.0, 330.0)
+    nodes: int = 2
+
+    def __post_init__(self) -> None:
+        if not (isinstance(self.n_targets, int) and self.n_targets >= 1):
+            raise ValueError(f"n_targets must be a positive integer, got {self.n_targets!r}")
+        if self.tracker not in TRACKERS:
+            raise ValueError(f"tracker must be one of {TRACKERS}, got {self.tracker!r}")
+        if not (self.period > 0 and self.duration >= 2 * self.period):
+            raise ValueError(f"need period > 0 and duration >= 2 periods, got "
+                             f"{self.period!r}, {self.duration!r}")
+        if self.nodes not in (2, 3):
+            raise ValueError(f"nodes must be 2 or 3, got {self.nodes!r}")
+        for name in ("freq_range", "pw_range", "pri_range", "turn_start", "turn_duration",
+                     "turn_accel"):
+            lo, hi = getattr(self, name)
+            if not lo <= hi:
+                raise ValueError(f"{name} must be (low, high) with low <= high")
+
+    def as_dict(self) -> dict:
+        return {k: (list(v) if isinstance(v, tuple) else v) for k, v in asdict(self).items()}
+
+    # ------------------------------------------------------------------ sensors
+    def systems(self) -> list[TdoaSystem]:
+        """The TDOA systems: the paper's two, and (``nodes=3``, ours) a third at (0, 100 km)
+        with 28 km baselines."""
+        mains, Ls, sig = PAPER["main_stations_m"], PAPER["baselines_m"], PAPER["tdoa_sigma_s"]
+        out = [TdoaSystem(tuple(mains[n]), Ls[n], sig[n], self.baseline_angles_deg)
+               for n in range(2)]
+        if self.nodes == 3:
+            out.append(TdoaSystem((0.0, 100e3), 28e3, 30e-9, self.baseline_angles_deg))
+        return out
+
+    def feature_sigmas(self) -> np.ndarray:
+        """``(nodes, 3)`` RMS errors of frequency (MHz), PW and PRI (us)."""
+        s = np.array([PAPER["freq_sigma_mhz"], PAPER["pw_sigma_us"], PAPER["pri_sigma_us"]]).T
+        return np.vstack([s, s.mean(axis=0)]) if self.nodes == 3 else s
+
+    # ------------------------------------------------------------------ truth
+    def trajectories(self, rng: np.random.Generator) -> np.ndarray:
+        """True states ``(K0, N, 4)`` at scans ``0, T, 2T, ...`` up to ``duration``."""
+        N, T = self.n_targets, self.period
+        K0 = int(round(self.duration / T)) + 1
+        lo, hi = PAPER["initial_position_m"]
+        pos = rng.uniform(lo, hi, size=(N, 2))
+        speed = rng.uniform(*PAPER["speed_range_mps"], size=N)
+        head = rng.uniform(0.0, 2 * np.pi, size=N)
+        vel = speed[:, None] * np.stack([np.cos(head), np.sin(head)], axis=1)
+        t0 = rng.uniform(*self.turn_start, size=N)
+        t1 = t0 + rng.uniform(*self.turn_duration, size=N)
+        acc = rng.uniform(*self.turn_accel, size=N) * rng.choice([-1.0, 1.0], size=N)
+        out = np.empty((K0, N, 4))
+        out[0] = np.hstack([pos, vel])
+        for k in range(1, K0):
+            t = (k - 1) * T
+            turning = (t >= t0) & (t < t1)
+            w = np.where(turning, acc / np.maximum(np.linalg.norm(vel, axis=1), 1.0), 0.0) * T
+            c, s = np.cos(w), np.sin(w)
+            new = np.stack([c * vel[:, 0] - s * vel[:, 1], s * vel[:, 0] + c * vel[:, 1]], 1)
+            pos = pos + 0.5 * T * (vel + new)
+            vel = new + rng.normal(0.0, np.sqrt(self.q_true * T), size=(N, 2))
+            out[k] = np.hstack([pos, vel])
+        return out
+
+    # ------------------------------------------------------------------ tracking
+    def track(self, system: TdoaSystem, truth: np.ndarray, rng: np.random.Generator
+              ) -> tuple[np.ndarray, np.ndarray]:
+        """One node's track estimates ``(K, N, 4)``, ``(K, N, 4, 4)`` at scans 1..K0-1."""
+        F, Q = cv_model(self.period, self.q_filter)
+        K0, N = truth.shape[:2]
+        tdoa = np.stack([system.tdoa(truth[k, :, :2], rng) for k in range(K0)])
+        f0, f1 = system.fix(tdoa[0]), system.fix(tdoa[1])
+        x, P = two_point_init(f0.position, f0.covariance, f1.position, f1.covariance,
+                              self.period)
+        xs, Ps = [x], [P]
+        R = system.range_sigma ** 2 * np.eye(3)
+        Hpos = np.hstack([np.eye(2), np.zeros((2, 2))])
+        for k in range(2, K0):
+            x, P = predict(x, P, F, Q)
+            if self.tracker == "ekf":
+                J = system.jacobian(x[:, :2])
+                H = np.concatenate([J, np.zeros(J.shape)], axis=-1)
+                res = C_LIGHT * tdoa[k] - system.range_differences(x[:, :2])
+                x, P = update(x, P, res, H, R)
+            else:
+                fx = system.fix(tdoa[k])
+                x, P = update(x, P, fx.position - x[:, :2], Hpos, fx.covariance)
+            xs.append(x)
+            Ps.append(P)
+        return np.stack(xs), np.stack(Ps)
+
+    def simulate(self, rng: np.random.Generator) -> Yan2010Run:
+        """Truth, both (or three) nodes' tracks and measured features; seeded by ``rng``."""
+        truth = self.trajectories(rng)
+        N = self.n_targets
+        emit = np.stack([rng.uniform(*self.freq_range, size=N), rng.uniform(*self.pw_range, size=N),
+                         rng.uniform(*self.pri_range, size=N)], axis=1)
+        sig = self.feature_sigmas()
+        K = truth.shape[0] - 1
+        xs, Ps, feats = [], [], []
+        perms = [np.arange(N)] + [rng.permutation(N) for _ in range(self.nodes - 1)]
+        for n, system in enumerate(self.systems()):
+            x, P = self.track(system, truth, rng)
+            f = emit[None] + rng.normal(size=(K, N, 3)) * sig[n]
+            p = perms[n]                         # node n's track j is emitter p[j]
+            xs.append(x[:, p])
+            Ps.append(P[:, p])
+            feats.append(f[:, p])
+        partners = tuple(np.argsort(p) for p in perms)
+        times = self.period * np.arange(1, K + 1)
+        return Yan2010Run(times, truth[1:], tuple(xs), tuple(Ps), tuple(feats), partners[1],
+                          partners)
+
+
+#: Names of the parameters that are ours (every field of :class:`Yan2010`).
+OURS = tuple(f.name for f in fields(Yan2010))
