@@ -19,7 +19,7 @@ from pathlib import Path
 from typing import Any, Callable, Mapping
 
 from ..errors import AssocoptError
-from . import lu2013, xue1999, zhang2009
+from . import lu2013, xue1999, yan2010, zhang2009
 
 __all__ = ["PAPERS", "Paper", "list_papers", "reproduce", "run"]
 
@@ -50,6 +50,10 @@ PAPERS: dict[str, Paper] = {
                      "Xue et al. 1999, distributed inference decision (DID) against GNN and "
                      "nearest neighbour on four crossing targets",
                      200, xue1999.run, "docs/papers/xue1999.md"),
+    "yan2010": Paper("yan2010", "001",
+                     "Yan et al. 2010, multi-feature D-S track-to-track association for "
+                     "passive TDOA systems: Table 1, Fig. 4",
+                     100, yan2010.run, "docs/papers/yan2010.md"),
 }
 
 

@@ -9,18 +9,24 @@ manoeuvres and velocity process noise; fixed frequency, PW and PRI; local tracki
 an extended Kalman filter.  Everything else is ours (:data:`OURS`, the fields of
 :class:`Yan2010` not in :data:`PAPER`), recorded with every result:
 
-* sampling period 1 s, time 0..80 s; tracks start at the second scan (two-point
-  initialisation from the first two fixes);
+* sampling period 1 s, time 0..80 s; tracks report from the second scan on
+  (``init="two-point"``: state from the first two fixes; ``"one-point"``: the first fix,
+  zero velocity with the speed prior's variance, then filtered);
 * the baselines point at 90, 210 and 330 degrees;
 * velocity process noise: a random walk of intensity ``q_true`` (m^2/s^3);
 * manoeuvres: every emitter makes one coordinated turn, starting at a time uniform
   in ``turn_start``, lasting ``turn_duration``, with lateral acceleration uniform in
   ``turn_accel`` (sign random);
-* emitter parameters uniform in ``freq_range`` (MHz), ``pw_range`` and ``pri_range``
-  (microseconds), measured afresh at every scan with the paper's RMS errors;
+* emitter parameters: a catalogue of ``emitter_types`` radar types with frequency,
+  PW and PRI uniform in ``freq_range`` (MHz), ``pw_range`` and ``pri_range``
+  (microseconds); each emitter carries a type drawn uniformly, so emitters of one type
+  share their nominal parameters (``emitter_types = 0``: every emitter its own draw);
+  measured afresh at every scan with the paper's RMS errors;
 * trackers (``tracker``): ``"ekf"`` -- the paper's EKF on the three range differences;
   ``"kf-fix"`` -- a linear Kalman filter on the linear TDOA fixes with their
   covariances; both with the nearly-constant-velocity model of intensity ``q_filter``;
+* ``region_scale`` shrinks the box of initial positions (1 = the paper's; a stress
+  test only);
 * node 2 numbers its tracks in a random order (the association is not given away).
 """
 
@@ -34,9 +40,10 @@ import numpy as np
 from ..filters import cv_model, predict, two_point_init, update
 from ..localisation.tdoa import C_LIGHT, TdoaSystem
 
-__all__ = ["PAPER", "OURS", "TRACKERS", "Yan2010", "Yan2010Run"]
+__all__ = ["PAPER", "OURS", "TRACKERS", "INITS", "Yan2010", "Yan2010Run"]
 
 TRACKERS = ("ekf", "kf-fix")
+INITS = ("two-point", "one-point")
 
 #: The paper's parameters (metres, seconds, MHz, microseconds).
 PAPER = {
@@ -82,6 +89,7 @@ class Yan2010:
     duration: float = 80.0
     period: float = 1.0
     tracker: str = "ekf"
+    init: str = "two-point"
     q_true: float = 1.0
     q_filter: float = 20.0
     turn_start: tuple[float, float] = (10.0, 60.0)
@@ -90,6 +98,8 @@ class Yan2010:
     freq_range: tuple[float, float] = (9000.0, 9400.0)
     pw_range: tuple[float, float] = (0.5, 1.5)
     pri_range: tuple[float, float] = (900.0, 1100.0)
+    emitter_types: int = 10
+    region_scale: float = 1.0
     baseline_angles_deg: tuple[float, float, float] = (90.0, 210.0, 330.0)
     nodes: int = 2
 
@@ -101,6 +111,12 @@ class Yan2010:
         if not (self.period > 0 and self.duration >= 2 * self.period):
             raise ValueError(f"need period > 0 and duration >= 2 periods, got "
                              f"{self.period!r}, {self.duration!r}")
+        if not self.region_scale > 0:
+            raise ValueError(f"region_scale must be > 0, got {self.region_scale!r}")
+        if self.init not in INITS:
+            raise ValueError(f"init must be one of {INITS}, got {self.init!r}")
+        if not (isinstance(self.emitter_types, int) and self.emitter_types >= 0):
+            raise ValueError(f"emitter_types must be an integer >= 0, got {self.emitter_types!r}")
         if self.nodes not in (2, 3):
             raise ValueError(f"nodes must be 2 or 3, got {self.nodes!r}")
         for name in ("freq_range", "pw_range", "pri_range", "turn_start", "turn_duration",
@@ -133,7 +149,7 @@ class Yan2010:
         """True states ``(K0, N, 4)`` at scans ``0, T, 2T, ...`` up to ``duration``."""
         N, T = self.n_targets, self.period
         K0 = int(round(self.duration / T)) + 1
-        lo, hi = PAPER["initial_position_m"]
+        lo, hi = (self.region_scale * v for v in PAPER["initial_position_m"])
         pos = rng.uniform(lo, hi, size=(N, 2))
         speed = rng.uniform(*PAPER["speed_range_mps"], size=N)
         head = rng.uniform(0.0, 2 * np.pi, size=N)
@@ -154,6 +170,15 @@ class Yan2010:
             out[k] = np.hstack([pos, vel])
         return out
 
+    def emitters(self, rng: np.random.Generator) -> np.ndarray:
+        """Nominal (frequency, PW, PRI) per emitter ``(N, 3)``: drawn from a catalogue of
+        ``emitter_types`` radar types (each emitter a type uniformly at random), or one
+        draw per emitter when ``emitter_types`` is 0."""
+        n = self.emitter_types or self.n_targets
+        cat = np.stack([rng.uniform(*r, size=n) for r in
+                        (self.freq_range, self.pw_range, self.pri_range)], axis=1)
+        return cat[rng.integers(n, size=self.n_targets)] if self.emitter_types else cat
+
     # ------------------------------------------------------------------ tracking
     def track(self, system: TdoaSystem, truth: np.ndarray, rng: np.random.Generator
               ) -> tuple[np.ndarray, np.ndarray]:
@@ -162,12 +187,19 @@ class Yan2010:
         K0, N = truth.shape[:2]
         tdoa = np.stack([system.tdoa(truth[k, :, :2], rng) for k in range(K0)])
         f0, f1 = system.fix(tdoa[0]), system.fix(tdoa[1])
-        x, P = two_point_init(f0.position, f0.covariance, f1.position, f1.covariance,
-                              self.period)
-        xs, Ps = [x], [P]
+        if self.init == "two-point":
+            x, P = two_point_init(f0.position, f0.covariance, f1.position, f1.covariance,
+                                  self.period)
+            xs, Ps, first = [x], [P], 2
+        else:
+            x = np.concatenate([f0.position, np.zeros((N, 2))], axis=1)
+            vv = PAPER["speed_range_mps"][1] ** 2 / 2 * np.eye(2)   # E|v|^2 / 2 per axis
+            P = np.zeros((N, 4, 4))
+            P[:, :2, :2], P[:, 2:, 2:] = f0.covariance, vv
+            xs, Ps, first = [], [], 1
         R = system.range_sigma ** 2 * np.eye(3)
         Hpos = np.hstack([np.eye(2), np.zeros((2, 2))])
-        for k in range(2, K0):
+        for k in range(first, K0):
             x, P = predict(x, P, F, Q)
             if self.tracker == "ekf":
                 J = system.jacobian(x[:, :2])
@@ -185,8 +217,7 @@ class Yan2010:
         """Truth, both (or three) nodes' tracks and measured features; seeded by ``rng``."""
         truth = self.trajectories(rng)
         N = self.n_targets
-        emit = np.stack([rng.uniform(*self.freq_range, size=N), rng.uniform(*self.pw_range, size=N),
-                         rng.uniform(*self.pri_range, size=N)], axis=1)
+        emit = self.emitters(rng)
         sig = self.feature_sigmas()
         K = truth.shape[0] - 1
         xs, Ps, feats = [], [], []
