@@ -111,7 +111,10 @@ def test_every_table_on_the_page_comes_from_the_committed_summary():
     generated = set(_page_table_rows(render_tables(summary)))
     page = PAGE.read_text(encoding="utf-8")
     rows = _page_table_rows(page)
-    numeric = [r for r in rows if re.search(r"\d\.\d{4}", r)]
+    tol = next(r for r in rows if r.startswith("| tolerances |"))
+    f, pw, pri = summary["parameters"]["ours"]["tolerances_f_pw_pri"]
+    assert f"{f:.2f} MHz, {pw:.4f} µs, {pri:.4f} µs" in tol
+    numeric = [r for r in rows if re.search(r"\d\.\d{4}", r) and r is not tol]
     assert len(numeric) >= 20, "the page shows the reproduction's tables"
     missing = [r for r in numeric if r not in generated]
     assert not missing, "page rows not produced from summary.json:\n" + "\n".join(missing[:10])
@@ -130,3 +133,11 @@ def test_the_page_states_the_run_behind_it():
     m = re.search(r"wall time (\d+) min (\d+) s", page)
     assert m, "the page gives the full run's wall time"
     assert int(m.group(1)) * 60 + int(m.group(2)) == pytest.approx(wall, abs=1.0)
+    parts = {"Table 1": "table1", "Fig. 4": "fig4", "sensitivity": "sensitivity",
+             "three nodes": "three_node"}
+    for label, name in parts.items():
+        m = re.search(r"\s+".join(map(re.escape, label.split())) +
+                      r"\s+(?:(\d+) min\s+)?(\d+) s\b", page)
+        assert m, label
+        shown = int(m.group(1) or 0) * 60 + int(m.group(2))
+        assert shown == pytest.approx(summary["timing"][f"yan2010-{name}"]["wall_s"], abs=1.0)
