@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import dataclasses
+import math
 import time
 from typing import Any
 
@@ -106,19 +108,20 @@ def solve(problem: AssignmentProblem, solver: str = "auto", *, relax: str | None
     opts = SolveOptions(relax=relax, time_limit=time_limit, mip_gap=mip_gap,
                         threads=threads, verbose=verbose, extra=parsed, parsed=True)
 
-    missing = problem.uncovered()
-    if missing:
+    n_missing = problem.n_uncovered
+    if n_missing:
+        missing = problem.uncovered(limit=20)
         a, i = missing[0]
-        more = f" (and {len(missing) - 1} more)" if len(missing) > 1 else ""
+        more = f" (and {n_missing - 1} more)" if n_missing > 1 else ""
         raw = RawResult(Status.INFEASIBLE,
                         message=f"infeasible: {index_label(a, i)} is covered by no "
                                 f"candidate{more}",
-                        info={"uncovered": missing[:20]})
+                        info={"uncovered": missing})
     elif problem.n_rows == 0:
         raw = empty_answer(problem, opts)
     else:
         k0 = spent()
-        raw = backend_cls().solve(problem, opts)
+        raw = _solve_scaled(backend_cls(), problem, opts)
         _kernel_times(raw, k0)
     sol = _finalise(problem, backend_cls, raw, relax)
     sol.info.setdefault("options", parsed)
@@ -133,6 +136,32 @@ def _kernel_times(raw: RawResult, before: tuple[float, float]) -> None:
     compiled, loaded = (a - b for a, b in zip(spent(), before))
     if compiled > 0 or loaded > 0:
         raw.info = dict(raw.info, compile_time=compiled, cache_load_time=loaded)
+#: Costs larger than this in magnitude are scaled by a power of two before a back end
+#: sees them (exact in floating point), so that HiGHS (which treats |c| >= 1e20 as
+#: infinite), CP-SAT's integer scaling and the Lagrangian sums all work on moderate
+#: numbers; the objective is recomputed from the original costs, the bound scaled back.
+SCALE_ABOVE = 2.0 ** 50
+_SCALE_TO_EXPONENT = 40
+
+
+def _solve_scaled(backend: Backend, problem: AssignmentProblem,
+                  opts: SolveOptions) -> RawResult:
+    """``backend.solve`` on ``problem`` with its costs scaled into a safe range if needed."""
+    amax = float(np.abs(problem.costs).max(initial=0.0))
+    if amax <= SCALE_ABOVE:
+        return backend.solve(problem, opts)
+    shift = math.frexp(amax)[1] - _SCALE_TO_EXPONENT
+    factor = math.ldexp(1.0, shift)
+    scaled = dataclasses.replace(problem, costs=np.ldexp(problem.costs, -shift),
+                                 optimum=None, meta=dict(problem.meta))
+    scaled.costs.setflags(write=False)
+    raw = backend.solve(scaled, opts)
+    if raw.bound is not None and math.isfinite(raw.bound):
+        raw.bound = raw.bound * factor
+    if raw.objective is not None and math.isfinite(raw.objective):
+        raw.objective = raw.objective * factor
+    raw.info = {**raw.info, "cost_scale": factor}
+    return raw
 
 
 _INTEGRAL_TOL = 1e-6

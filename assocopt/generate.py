@@ -257,10 +257,10 @@ def feasibility(problem: AssignmentProblem, *, time_limit: float | None = 60.0
     """
     from .problem import index_label
 
-    missing = problem.uncovered()
-    if missing:
-        a, i = missing[0]
-        more = f" (and {len(missing) - 1} more)" if len(missing) > 1 else ""
+    n_missing = problem.n_uncovered
+    if n_missing:
+        a, i = problem.uncovered(limit=1)[0]
+        more = f" (and {n_missing - 1} more)" if n_missing > 1 else ""
         return False, f"{index_label(a, i)} is covered by no candidate{more}"
     R = problem.entry_rows[(problem.tuples > 0).sum(axis=1) == 1]
     hit = np.zeros(problem.n_rows, dtype=bool)

@@ -19,6 +19,7 @@ import numpy as np
 from numpy.typing import ArrayLike
 
 from .errors import InvalidProblemError
+from .validation import require_memory
 
 if TYPE_CHECKING:   # pragma: no cover
     import scipy.sparse as sp
@@ -90,6 +91,8 @@ class IndexArithmetic:
 
         R = self.entry_rows if pos is None else self.entry_rows[np.asarray(pos, np.int64)]
         real = R >= 0
+        require_memory(8 * (self.n_rows + 1) + 16 * int(real.sum()), "the constraint matrix",
+                       f"{self.n_rows} rows x {len(R)} candidates")
         cols = np.broadcast_to(np.arange(len(R))[:, None], R.shape)[real]
         A = sp.csr_matrix((np.ones(len(cols)), (R[real], cols)),
                           shape=(self.n_rows, len(R)))
@@ -101,16 +104,37 @@ class IndexArithmetic:
         R = self.entry_rows if pos is None else self.entry_rows[np.asarray(pos, np.int64)]
         return np.flatnonzero(np.bincount(R[R >= 0], minlength=self.n_rows) == 0)
 
-    def uncovered(self) -> list[tuple[int, int]]:
-        """Real indices ``(axis, index)`` that no candidate covers (1-based index).
+    def uncovered(self, limit: int | None = None) -> list[tuple[int, int]]:
+        """Real indices ``(axis, index)`` that no candidate covers (1-based index),
+        at most ``limit`` of them (all when None); :attr:`n_uncovered` counts them.
 
-        Any such index makes the problem infeasible.
+        Any such index makes the problem infeasible.  Computed from the candidates
+        alone (sorted covered indices per axis), never with an array of ``n_s``
+        entries, so huge declared sizes with few candidates cost nothing.
         """
-        return list(self._uncovered)
+        if limit is None:
+            limit = self.n_uncovered
+        out: list[tuple[int, int]] = []
+        for axis, covered in enumerate(self._covered):
+            prev = 0
+            for c in list(covered) + [self.sizes[axis] + 1]:
+                for i in range(prev + 1, min(int(c), prev + 1 + limit - len(out))):
+                    out.append((axis, i))
+                if len(out) >= limit:
+                    return out
+                prev = int(c)
+        return out
+
+    @property
+    def n_uncovered(self) -> int:
+        """How many real indices no candidate covers (0 for a feasible-looking problem)."""
+        return int(sum(n - len(c) for n, c in zip(self.sizes, self._covered)))
 
     @functools.cached_property
-    def _uncovered(self) -> tuple[tuple[int, int], ...]:
-        return tuple(self.axis_index(int(r)) for r in self.uncovered_rows())
+    def _covered(self) -> tuple[np.ndarray, ...]:
+        """Sorted distinct real indices each axis's candidates cover."""
+        T = self.tuples
+        return tuple(np.unique(T[:, s][T[:, s] > 0]) for s in range(len(self.sizes)))
 
     def axis_index(self, row: int) -> tuple[int, int]:
         """``(axis, real index)`` (index 1-based) of constraint row ``row``."""

@@ -36,6 +36,8 @@ from numpy.typing import ArrayLike
 from .errors import InvalidProblemError
 from .indexing import OPT_TOL, IndexArithmetic, index_label, kept_axes
 from .twod import MAX_DENSE_CANDIDATES, LazyView, from_matrix, miss_vector
+from .validation import (MAX_ABS_COST, MAX_SIZE, check_sizes, check_tuples,  # noqa: F401
+                         require_memory)
 from .values import _as_cost_array, _as_matrix, _reject_non_finite
 
 __all__ = ["AssignmentProblem", "OPT_TOL", "kept_axes", "index_label", "MAX_DENSE_CANDIDATES"]
@@ -190,58 +192,11 @@ class AssignmentProblem(IndexArithmetic):
 
     @staticmethod
     def _check_sizes(sizes: Sequence[int]) -> tuple[int, ...]:
-        try:
-            arr = np.asarray(sizes)
-        except (TypeError, ValueError) as exc:
-            raise InvalidProblemError(f"sizes must be a sequence of integers: {exc}") from exc
-        if arr.ndim != 1 or len(arr) < 2:
-            raise InvalidProblemError(
-                f"sizes must list at least 2 axes, got {list(np.atleast_1d(arr))}")
-        if arr.dtype.kind not in "iuf" or (arr.dtype.kind == "f" and
-                                           not np.all(arr == np.round(arr))):
-            raise InvalidProblemError(f"sizes must be integers, got {arr.tolist()}")
-        if (arr < 0).any():
-            raise InvalidProblemError(f"sizes must be non-negative, got {arr.tolist()}")
-        return tuple(int(n) for n in arr)
+        return check_sizes(sizes)
 
     @staticmethod
     def _check_tuples(tuples: ArrayLike, sizes: tuple[int, ...]) -> np.ndarray:
-        N = len(sizes)
-        try:
-            raw = np.asarray(tuples)
-        except (TypeError, ValueError) as exc:
-            raise InvalidProblemError(f"tuples must be an integer array: {exc}") from exc
-        if raw.size == 0:
-            raw = raw.reshape(0, N)
-        if raw.ndim != 2 or raw.shape[1] != N:
-            raise InvalidProblemError(
-                f"tuples must have shape (K, {N}) for {N} axes, got shape {raw.shape}")
-        if raw.dtype.kind == "f":
-            if not np.all(np.isfinite(raw)) or not np.all(raw == np.round(raw)):
-                bad = int(np.argwhere(~np.isfinite(raw) | (raw != np.round(raw)))[0, 0])
-                raise InvalidProblemError(
-                    f"tuple {bad} has a non-integer index: {raw[bad].tolist()}")
-        elif raw.dtype.kind not in "iub":
-            raise InvalidProblemError(f"tuples must be integers, got dtype {raw.dtype}")
-        T = raw.astype(np.int64)
-        upper = np.asarray(sizes, dtype=np.int64)
-        bad_rows = np.flatnonzero(((T < 0) | (T > upper)).any(axis=1))
-        if len(bad_rows):
-            k = int(bad_rows[0])
-            raise InvalidProblemError(
-                f"tuple {k} = {T[k].tolist()} has an index out of range: axis s takes "
-                f"0 (dummy) .. n_s with sizes {list(sizes)}")
-        all_dummy = np.flatnonzero((T == 0).all(axis=1))
-        if len(all_dummy):
-            raise InvalidProblemError(
-                f"tuple {int(all_dummy[0])} is the all-dummy tuple {T[all_dummy[0]].tolist()}, "
-                "which is never a candidate (it covers no real index)")
-        if len(T) > 1:
-            _, first, counts = np.unique(T, axis=0, return_index=True, return_counts=True)
-            if (counts > 1).any():
-                dup = T[first[np.argmax(counts > 1)]]
-                raise InvalidProblemError(f"duplicate candidate tuple {dup.tolist()}")
-        return T
+        return check_tuples(tuples, sizes)
 
     @classmethod
     def _build(cls, sizes, tuples, costs, slack, **kw) -> "AssignmentProblem":
@@ -275,10 +230,20 @@ class AssignmentProblem(IndexArithmetic):
         off.setflags(write=False)
         return off
 
-    def uncovered(self) -> list[tuple[int, int]]:
-        """Real indices ``(axis, index)`` that no candidate covers (1-based index); for
-        a dense 2-D problem read from the matrix, without building the candidate list."""
-        return self._dense.uncovered() if self._dense is not None else super().uncovered()
+    def uncovered(self, limit: int | None = None) -> list[tuple[int, int]]:
+        """Real indices ``(axis, index)`` that no candidate covers (1-based index), at
+        most ``limit``; for a dense 2-D problem read from the matrix, without building
+        the candidate list (else from the candidates alone, see IndexArithmetic)."""
+        if self._dense is not None:
+            return self._dense.uncovered()[:limit]
+        return super().uncovered(limit)
+
+    @property
+    def n_uncovered(self) -> int:
+        """How many real indices no candidate covers."""
+        if self._dense is not None:
+            return len(self._dense.uncovered())
+        return super().n_uncovered
 
     # ------------------------------------------------------------- solutions
     def violations(self, selected: ArrayLike) -> str | None:
@@ -291,11 +256,15 @@ class AssignmentProblem(IndexArithmetic):
         if len(np.unique(sel)) != len(sel):
             return "a candidate is selected twice"
         R = self.entry_rows[sel]
-        count = np.bincount(R[R >= 0], minlength=self.n_rows)
-        bad = np.flatnonzero(count != 1)
-        if len(bad):
-            r = int(bad[0])
-            return f"{self.row_label(r)} is covered {int(count[r])} times, not once"
+        rows, count = np.unique(R[R >= 0], return_counts=True)
+        twice = np.flatnonzero(count > 1)
+        if len(twice):
+            r = int(rows[twice[0]])
+            return f"{self.row_label(r)} is covered {int(count[twice[0]])} times, not once"
+        if len(rows) < self.n_rows:
+            gap = np.flatnonzero(rows != np.arange(len(rows)))
+            r = int(gap[0]) if len(gap) else len(rows)
+            return f"{self.row_label(r)} is covered 0 times, not once"
         return None
 
     def objective_of(self, selected: ArrayLike) -> float:
@@ -312,6 +281,8 @@ class AssignmentProblem(IndexArithmetic):
         """Dense array of the all-real candidates' costs (``fill`` elsewhere)."""
         if self._dense is not None and fill == np.inf:
             return self._dense.C.copy()
+        require_memory(8 * math.prod(self.sizes), "the dense cost array",
+                       "shape " + " x ".join(map(str, self.sizes)))
         M = np.full(self.sizes, fill, dtype=np.float64)
         real = (self.tuples > 0).all(axis=1)
         M[tuple((self.tuples[real] - 1).T)] = self.costs[real]

@@ -3,7 +3,8 @@
 Every constructor turns its values into a fresh float64 array in the minimisation sense
 (negated for ``maximize=True``), tests it once (its sum is finite) and only when
 that fails looks for what is wrong: NaN, or the infinity that does not mean "forbidden"
-(``-inf`` for costs, ``+inf`` for scores).
+(``-inf`` for costs, ``+inf`` for scores).  Complex, boolean and text data and finite
+magnitudes beyond ``validation.MAX_ABS_COST`` (1e300) are rejected first.
 """
 
 from __future__ import annotations
@@ -14,6 +15,7 @@ import numpy as np
 from numpy.typing import ArrayLike
 
 from .errors import InvalidProblemError
+from .validation import check_cost_dtype, check_cost_range
 
 __all__ = ["_as_cost_array", "_as_matrix", "_reject_non_finite"]
 
@@ -41,10 +43,9 @@ def _reject_non_finite(arr: np.ndarray, what: str, maximize: bool) -> None:
 def _as_matrix(values: ArrayLike, what: str, maximize: bool) -> tuple[np.ndarray, bool]:
     """A fresh float64 array in the minimisation sense and whether all of it is finite;
     NaN and the wrong infinity are rejected (checked only when not all finite)."""
-    try:
-        arr = np.array(values, dtype=np.float64)
-    except (TypeError, ValueError) as exc:
-        raise InvalidProblemError(f"{what} must be numeric: {exc}") from exc
+    raw = check_cost_dtype(values, what)      # complex, booleans, text, huge integers
+    arr = np.array(raw, dtype=np.float64)
+    check_cost_range(arr, what)               # |c| <= MAX_ABS_COST: no sum can overflow
     if maximize:
         np.negative(arr, out=arr)
     # One pass, no temporary: a finite sum means no NaN and no infinity (a huge but

@@ -6,8 +6,9 @@ Every failure ends here as one ``assocopt: error: ...`` line on stderr and an ex
 
 from __future__ import annotations
 
+import argparse
 import sys
-from typing import Sequence
+from typing import Sequence, TextIO
 
 from ..errors import AssocoptError
 from .common import (EXIT_BAD_INPUT, EXIT_BROKEN_PIPE, EXIT_INTERNAL, EXIT_INTERRUPTED,
@@ -18,18 +19,71 @@ from .workflow_cmds import (_cmd_convert, _cmd_export, _cmd_generate, _cmd_insta
                             _cmd_models, _cmd_reproduce)
 
 
+_COMMANDS = {"solve": _cmd_solve, "solvers": _cmd_solvers, "models": _cmd_models,
+             "compare": _cmd_compare, "validate": _cmd_validate,
+             "export": _cmd_export, "generate": _cmd_generate,
+             "convert": _cmd_convert, "instances": _cmd_instances,
+             "reproduce": _cmd_reproduce}
+
+
+def _terminate(signum: int, frame: object) -> None:
+    """SIGTERM / SIGHUP: unwind like Ctrl-C, so temporary files are removed."""
+    raise KeyboardInterrupt
+
+
+def _run(args: argparse.Namespace, out: TextIO, err: TextIO) -> int:
+    """Run one subcommand, with ``--max-bytes`` in force and termination signals
+    unwinding the stack (cleanup in ``finally`` blocks) instead of killing at once."""
+    import os
+    import signal
+    import threading
+
+    from ..io.common import MAX_BYTES_ENV
+
+    saved_env = os.environ.get(MAX_BYTES_ENV)
+    saved_sig = {}
+    if threading.current_thread() is threading.main_thread():
+        for sig in (signal.SIGTERM, getattr(signal, "SIGHUP", None)):
+            if sig is not None and signal.getsignal(sig) in (signal.SIG_DFL, None):
+                saved_sig[sig] = signal.signal(sig, _terminate)
+    try:
+        if args.max_bytes is not None:
+            os.environ[MAX_BYTES_ENV] = str(args.max_bytes)
+        return _COMMANDS[args.command](args, out, err)
+    finally:
+        for sig, old in saved_sig.items():
+            signal.signal(sig, old)
+        if args.max_bytes is not None:
+            if saved_env is None:
+                os.environ.pop(MAX_BYTES_ENV, None)
+            else:
+                os.environ[MAX_BYTES_ENV] = saved_env
+
+
+def _exit_now_if_solver_threads(as_program: bool) -> None:
+    """After a Ctrl-C that stopped a solve running in a worker thread, leave at once:
+    native solver threads still winding down can make interpreter finalisation abort
+    (SIGABRT instead of exit 130).  Only when run as the program (``main()`` without
+    ``argv``), never inside a caller's process."""
+    mod = sys.modules.get("assocopt.solvers.interruptible")
+    if mod is None or not mod.INTERRUPTED.is_set() or not as_program:
+        return
+    import os
+    for stream in (sys.stdout, sys.stderr):
+        try:
+            stream.flush()
+        except (OSError, ValueError):
+            pass
+    os._exit(EXIT_INTERRUPTED)
+
+
 def main(argv: Sequence[str] | None = None) -> int:
     """Run the command line; returns the exit code (see :mod:`assocopt.cli`)."""
     out, err = sys.stdout, sys.stderr
     try:
         parser = _build_parser()
         args = parser.parse_args(list(sys.argv[1:] if argv is None else argv))
-        commands = {"solve": _cmd_solve, "solvers": _cmd_solvers, "models": _cmd_models,
-                    "compare": _cmd_compare, "validate": _cmd_validate,
-                    "export": _cmd_export, "generate": _cmd_generate,
-                    "convert": _cmd_convert, "instances": _cmd_instances,
-                    "reproduce": _cmd_reproduce}
-        return commands[args.command](args, out, err)
+        return _run(args, out, err)
     except SystemExit as exc:        # --help / --version
         code = exc.code
         return code if isinstance(code, int) else (0 if code is None else EXIT_BAD_INPUT)
@@ -51,6 +105,7 @@ def main(argv: Sequence[str] | None = None) -> int:
         return EXIT_BAD_INPUT
     except KeyboardInterrupt:
         print("assocopt: interrupted", file=err)
+        _exit_now_if_solver_threads(argv is None)
         return EXIT_INTERRUPTED
     except Exception as exc:  # noqa: BLE001 - the CLI never shows a traceback
         _error(err, f"internal error ({type(exc).__name__}: {_one_line(str(exc))}); "

@@ -28,6 +28,9 @@ def _build_parser() -> argparse.ArgumentParser:
                "a solution, 4 solver or internal error, 130 interrupted")
     from .. import __version__
     parser.add_argument("--version", action="version", version=f"assocopt {__version__}")
+    parser.add_argument("--max-bytes", type=_max_bytes, metavar="N", default=None,
+                        help="largest instance file read, in bytes (default 1 GiB; also "
+                             "the environment variable ASSOCOPT_MAX_BYTES)")
     sub = parser.add_subparsers(dest="command", metavar="COMMAND")
     sub.required = True
 
@@ -37,7 +40,7 @@ def _build_parser() -> argparse.ArgumentParser:
     ps.add_argument("file", metavar="FILE",
                     help="instance file, or the name of a stored instance (see "
                          "'assocopt instances')")
-    ps.add_argument("--solver", default=None,
+    ps.add_argument("--solver", type=_solver_name, default=None,
                     help="back end name (see 'assocopt solvers'); default: auto")
     ps.add_argument("--model", metavar="MODEL", default=None,
                     help="named model (file stem, see 'assocopt models', or a .toml path) "
@@ -74,6 +77,16 @@ def _build_parser() -> argparse.ArgumentParser:
     return parser
 
 
+def _max_bytes(text: str) -> int:
+    try:
+        value = int(float(text))
+    except (ValueError, OverflowError):
+        raise argparse.ArgumentTypeError(f"expected a number of bytes, got {text!r}") from None
+    if value < 1:
+        raise argparse.ArgumentTypeError(f"must be a positive number of bytes, got {text!r}")
+    return value
+
+
 def _sizes(text: str) -> tuple[int, ...]:
     parts = [t for t in text.replace("x", ",").split(",") if t.strip()]
     try:
@@ -89,10 +102,20 @@ def _sizes(text: str) -> tuple[int, ...]:
 
 
 def _names(text: str) -> list[str]:
-    names = [t.strip() for t in text.split(",") if t.strip()]
-    if not names:
+    parts = [t.strip() for t in text.split(",")]
+    if not any(parts):
         raise argparse.ArgumentTypeError("expected comma-separated names")
-    return names
+    if not all(parts):
+        raise argparse.ArgumentTypeError(f"empty name in {text!r}")
+    return parts
+
+
+def _solver_name(text: str) -> str:
+    """A back end name: an empty one is an error, not a silent ``auto``."""
+    if not text.strip():
+        raise argparse.ArgumentTypeError("empty solver name (give a name from "
+                                         "'assocopt solvers', or auto)")
+    return text.strip()
 
 
 def _add_input_args(p: argparse.ArgumentParser, formats: Sequence[str]) -> None:
@@ -216,6 +239,9 @@ def _add_more_parsers(sub: Any, formats: Sequence[str]) -> None:
     pr.add_argument("--list", action="store_true", help="list the papers")
     pr.add_argument("--runs", type=int, default=None, metavar="N", help="Monte Carlo runs")
     pr.add_argument("--workers", type=int, default=None, metavar="W", help="worker processes")
+    pr.add_argument("--scheduler", default=None, metavar="ADDRESS",
+                    help="run the trials on a dask.distributed cluster (e.g. "
+                         "tcp://10.0.0.5:8786; needs pip install 'assocopt[distributed]')")
     pr.add_argument("--seed", type=int, default=None, metavar="S", help="random seed")
     pr.add_argument("--out", default=None, metavar="DIR", help="output folder")
     pr.add_argument("--progress", action=argparse.BooleanOptionalAction, default=None,

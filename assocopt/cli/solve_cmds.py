@@ -14,7 +14,7 @@ from pathlib import Path
 from typing import Any, TextIO
 
 from ..errors import AssocoptError
-from .common import (EXIT_BAD_INPUT, EXIT_INTERNAL, EXIT_LIMIT, EXIT_OK, _error, _human,
+from .common import (EXIT_BAD_INPUT, EXIT_INFEASIBLE, EXIT_INTERNAL, EXIT_LIMIT, EXIT_OK, _error, _human,
                      _matches, _num, _one_line, _os_message, _solve_record, _table, exit_code)
 
 
@@ -113,6 +113,17 @@ def _cmd_kbest(args: argparse.Namespace, out: TextIO, err: TextIO) -> int:
             tup = " ".join("(" + ",".join(map(str, t)) + ")" for t in s.tuples.tolist())
             print(f"{s.info['rank']:>4}  {_num(s.objective):>14}  {tup}", file=out)
     return EXIT_OK if len(ranked) else 1
+def _check_options(time_limit: Any = None, mip_gap: Any = None, threads: Any = None) -> None:
+    """Validate the common solve options before any file is read or row is run: every
+    bad value is one ``assocopt: error:`` line and exit 2, for solve and compare alike."""
+    from ..solvers.options import check_common
+
+    try:
+        check_common(time_limit, 0.0 if mip_gap is None else mip_gap, threads, False)
+    except AssocoptError:
+        raise
+    except ValueError as exc:
+        raise AssocoptError(str(exc)) from None
 
 
 def _cmd_solve(args: argparse.Namespace, out: TextIO, err: TextIO) -> int:
@@ -121,6 +132,7 @@ def _cmd_solve(args: argparse.Namespace, out: TextIO, err: TextIO) -> int:
 
     if getattr(args, "kbest", None) is not None:
         return _cmd_kbest(args, out, err)
+    _check_options(args.time_limit, args.gap, args.threads)
 
     if args.model is not None:
         from ..models import load_model
@@ -167,6 +179,11 @@ def _cmd_solve(args: argparse.Namespace, out: TextIO, err: TextIO) -> int:
     if code == EXIT_INTERNAL:
         print(f"assocopt: error: solver {sol.solver!r} failed (internal error): "
               f"{_one_line(sol.message) or 'no message'}", file=err)
+    elif code == EXIT_INFEASIBLE:
+        why = _one_line(sol.message) or "no assignment covers every real index once"
+        if not why.startswith("infeasible"):
+            why = f"infeasible ({why})"
+        print(f"assocopt: {args.file}: {why}", file=err)
     elif code == EXIT_LIMIT:
         print("assocopt: error: stopped by a limit before any solution was found", file=err)
     return code
@@ -269,6 +286,7 @@ def _cmd_solvers(args: argparse.Namespace, out: TextIO, err: TextIO) -> int:
 def _cmd_compare(args: argparse.Namespace, out: TextIO, err: TextIO) -> int:
     from ..compare import compare
 
+    _check_options(args.time_limit)
     res = compare(args.files, solvers=args.solvers, models=args.models,
                   time_limit=args.time_limit, relax=args.relax, repeat=args.repeat,
                   format=args.format, instance=args.instance, progress=args.progress)

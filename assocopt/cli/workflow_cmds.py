@@ -15,7 +15,7 @@ from pathlib import Path
 from typing import Any, Sequence, TextIO
 
 from ..errors import AssocoptError
-from .common import EXIT_OK, _num, _table, _UsageError
+from .common import EXIT_OK, _num, _one_line, _table, _UsageError
 
 
 def _cmd_models(args: argparse.Namespace, out: TextIO, err: TextIO) -> int:
@@ -106,6 +106,24 @@ def _cmd_instances(args: argparse.Namespace, out: TextIO, err: TextIO) -> int:
     return EXIT_OK
 
 
+#: Seconds to wait for a dask scheduler to answer.
+SCHEDULER_TIMEOUT = 20.0
+
+
+def _dask_client(address: str) -> Any:
+    """A ``dask.distributed.Client`` connected to ``address``, or a clear error."""
+    try:
+        from distributed import Client
+    except ImportError:
+        raise AssocoptError("--scheduler needs dask.distributed: pip install "
+                            "'assocopt[distributed]'") from None
+    try:
+        return Client(address, timeout=SCHEDULER_TIMEOUT, set_as_default=False)
+    except (OSError, TimeoutError, ValueError) as exc:
+        raise AssocoptError(f"cannot connect to the dask scheduler {address!r}: "
+                            f"{_one_line(str(exc))}") from None
+
+
 def _cmd_reproduce(args: argparse.Namespace, out: TextIO, err: TextIO) -> int:
     import importlib
     import importlib.util
@@ -143,7 +161,14 @@ def _cmd_reproduce(args: argparse.Namespace, out: TextIO, err: TextIO) -> int:
     takes_any = any(p.kind is inspect.Parameter.VAR_KEYWORD for p in params.values())
     kwargs = {k: v for k, v in wanted.items()
               if v is not None and (takes_any or k in params)}
-    result = mod.reproduce(args.name, **kwargs)
+    if args.scheduler is not None:
+        if args.workers is not None:
+            raise AssocoptError("give --workers or --scheduler, not both (the cluster's "
+                                "workers run the trials)")
+        with _dask_client(args.scheduler) as client:
+            result = mod.reproduce(args.name, executor=client, **kwargs)
+    else:
+        result = mod.reproduce(args.name, **kwargs)
     where = args.out or (result.get("out") if isinstance(result, dict) else None)
     print(f"reproduced {args.name}" + (f": results in {where}" if where else ""), file=out)
     return EXIT_OK

@@ -8,6 +8,7 @@ from __future__ import annotations
 import concurrent.futures as cf
 import math
 import multiprocessing
+import os
 import time
 from pathlib import Path
 from typing import Any, Callable, Mapping, Sequence
@@ -139,8 +140,11 @@ def run_experiment(exp: Experiment, store: str | Path | ResultStore, *, workers:
 def _run_parallel(exp, st, keys, todo, workers, executor, bar) -> None:
     own = executor is None
     if own:
+        from ..parent_watch import watch_parent
+        # workers exit when this process dies, even by SIGKILL (see parent_watch)
         executor = cf.ProcessPoolExecutor(max_workers=workers,
-                                          mp_context=multiprocessing.get_context("spawn"))
+                                          mp_context=multiprocessing.get_context("spawn"),
+                                          initializer=watch_parent, initargs=(os.getpid(),))
     max_pending = 4 * workers if own else 64
     queue = list(reversed(todo))
     pending: dict[Any, int] = {}

@@ -9,6 +9,7 @@ the file and, where it can, the line of the bad token.
 
 from __future__ import annotations
 
+import os
 import re
 from pathlib import Path
 from typing import Any
@@ -26,9 +27,41 @@ def _fail(path: Path, message: str) -> InstanceFormatError:
     return InstanceFormatError(f"{path}: {message}")
 
 
+#: Default cap on the bytes an instance file may have (1 GiB: a dense JSON file of the
+#: largest accepted dense problem, 50 million costs, is about 0.5 GiB).  Override it with
+#: the environment variable ``ASSOCOPT_MAX_BYTES`` or the CLI's ``--max-bytes``.
+DEFAULT_MAX_BYTES = 2 ** 30
+MAX_BYTES_ENV = "ASSOCOPT_MAX_BYTES"
+#: Deepest nesting of JSON arrays / objects a file may have (an N-D cost array needs N
+#: levels; deeper files are rejected before parsing, never a RecursionError).
+MAX_JSON_DEPTH = 100
+
+
+def max_bytes() -> int:
+    """The current cap on an instance file's size (see :data:`DEFAULT_MAX_BYTES`)."""
+    raw = os.environ.get(MAX_BYTES_ENV)
+    if raw is None or not raw.strip():
+        return DEFAULT_MAX_BYTES
+    try:
+        value = int(float(raw))
+    except ValueError:
+        raise InstanceFormatError(f"{MAX_BYTES_ENV}={raw!r} is not a number of bytes") from None
+    if value < 1:
+        raise InstanceFormatError(f"{MAX_BYTES_ENV}={raw!r} must be a positive number of bytes")
+    return value
+
+
 def _read_text(path: Path) -> str:
+    limit = max_bytes()
     with open(path, "rb") as f:
-        data = f.read()
+        data = f.read(min(4096, limit + 1))
+        if b"\x00" in data:
+            raise _fail(path, "not a text file (contains NUL bytes)")
+        if len(data) <= limit:
+            data += f.read(limit + 1 - len(data))
+    if len(data) > limit:
+        raise _fail(path, f"the file is larger than the limit of {limit} bytes; raise it "
+                          f"with --max-bytes or the environment variable {MAX_BYTES_ENV}")
     if b"\x00" in data[:4096]:
         raise _fail(path, "not a text file (contains NUL bytes)")
     try:
@@ -117,3 +150,15 @@ def _cube_root(m: int) -> int | None:
         if c > 0 and c ** 3 == m:
             return c
     return None
+
+
+_JSON_STRING = re.compile(r'"(?:[^"\\]|\\.)*"')
+
+
+def _json_depth(text: str) -> int:
+    """Deepest nesting of ``[``/``{`` in JSON text (strings ignored), without recursion."""
+    bare = _JSON_STRING.sub('""', text).encode("utf-8", "replace")
+    b = np.frombuffer(bare, dtype=np.uint8)
+    step = (np.isin(b, (ord("["), ord("{"))).astype(np.int32)
+            - np.isin(b, (ord("]"), ord("}"))).astype(np.int32))
+    return int(np.cumsum(step).max(initial=0))

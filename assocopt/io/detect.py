@@ -61,14 +61,15 @@ def _matches(text: str) -> tuple[dict[str, tuple[bool, int, bool]], str]:
         n = int(lines[0][1])
         found["balas-saltzman-split"] = (L - 2 == n ** 3, n ** 3, True)
     elif one_per_line and len(lines[0]) == 1:
-        found["balas-saltzman-split"] = (_cube_root(L) is not None, L, False)
+        # headerless: n**3 numbers with n >= 2 (a lone number is no 1x1x1 problem)
+        found["balas-saltzman-split"] = (_cube_root(L) is not None and L >= 8, L, False)
     # OR-Library: n alone on line 1, then n*n costs (several per line in practice)
     if len(lines[0]) == 1 and _INTEGER.match(lines[0][0]) and int(lines[0][0]) > 0:
         n = int(lines[0][0])
         exact = L - 1 == n * n
         if exact or not one_per_line or len(lines) < 3:
             found["orlib"] = (exact, n * n, False)
-    if not found and _cube_root(L) is not None:
+    if not found and L >= 8 and _cube_root(L) is not None:
         # n**3 numbers laid out otherwise than one per line
         found["balas-saltzman-split"] = (True, L, False)
     return found, seen
@@ -85,6 +86,9 @@ def detect_format(path: str | os.PathLike[str], text: str | None = None) -> str:
     head = text.lstrip()
     if head.startswith(("{", "[")):
         return "assocopt"
+    if path.suffix.lower() == ".json":
+        raise _fail(path, f"invalid assocopt instance: expected a JSON object at the top "
+                          f"level, found {head[:40].split(chr(10))[0]!r}")
     if _BS_BLOCK.search(text) or "AP3 Test Driver" in text[:2000]:
         return "balas-saltzman"
     found, seen = _matches(text)

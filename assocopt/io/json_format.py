@@ -17,7 +17,8 @@ import numpy as np
 
 from ..errors import InvalidProblemError
 from ..problem import AssignmentProblem
-from .common import _fail
+from ..validation import MAX_ABS_COST
+from .common import MAX_JSON_DEPTH, _fail, _json_depth
 
 #: Value of the ``"format"`` key of the project's JSON instance files.
 FORMAT_NAME = "assocopt-instance"
@@ -52,6 +53,10 @@ def _parse_constant(name: str) -> float:
 def _cost_value(v: Any, where: str, path: Path) -> float:
     if isinstance(v, bool) or v is None:
         raise _fail(path, f"{where} must be a number or \"inf\", found {json.dumps(v)}")
+    if isinstance(v, int) and abs(v) > MAX_ABS_COST:
+        digits = len(str(abs(v)))
+        raise _fail(path, f"{where} is an integer of {digits} digits, outside the accepted "
+                          f"range |cost| <= {MAX_ABS_COST:g}")
     if isinstance(v, (int, float)):
         f = float(v)
         if math.isnan(f):
@@ -100,7 +105,7 @@ def _cost_array(v: Any, where: str, path: Path, min_ndim: int = 0) -> np.ndarray
             return
         for i, x in enumerate(node):
             t = type(x)
-            if t is int or t is float:
+            if t is float or (t is int and -MAX_ABS_COST <= x <= MAX_ABS_COST):
                 flat.append(x)
             elif isinstance(x, list):
                 raise _fail(path, f"ragged {where}: {here(idx + [i])} is a list, expected a "
@@ -131,12 +136,25 @@ def _int_list(v: Any, where: str, path: Path) -> list[int]:
     return out
 
 
+def _parse_float(text: str) -> float:
+    value = float(text)
+    if math.isinf(value):
+        raise ValueError(f"the number {text[:40]} is outside the float range")
+    return value
+
+
 def _read_json(path: Path, text: str) -> AssignmentProblem:
+    depth = _json_depth(text)
+    if depth > MAX_JSON_DEPTH:
+        raise _fail(path, f"invalid JSON: nested {depth} levels deep, more than the "
+                          f"{MAX_JSON_DEPTH} levels an instance file may have")
     try:
         doc = json.loads(text, object_pairs_hook=_no_duplicates,
-                         parse_constant=_parse_constant)
+                         parse_constant=_parse_constant, parse_float=_parse_float)
     except json.JSONDecodeError as exc:
         raise _fail(path, f"invalid JSON: {exc.msg} at line {exc.lineno} column {exc.colno}") from None
+    except RecursionError:
+        raise _fail(path, "invalid JSON: nested too deeply") from None
     except ValueError as exc:
         raise _fail(path, f"invalid JSON: {exc}") from None
     if not isinstance(doc, dict):
@@ -223,7 +241,7 @@ def _read_json(path: Path, text: str) -> AssignmentProblem:
                                   f"{len(T)}")
             c = np.array([_cost_value(v, f"costs[{k}]", path) for k, v in enumerate(costs)],
                          dtype=np.float64)
-            Ta = np.array(T, dtype=np.int64).reshape(len(T), len(sizes))
+            Ta = np.array(T) if T else np.zeros((0, len(sizes)), dtype=np.int64)
             p = AssignmentProblem.sparse(sizes, Ta, c, name=name, optimum=optimum)
     except InvalidProblemError as exc:
         raise _fail(path, f"invalid problem: {exc}") from exc

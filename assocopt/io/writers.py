@@ -10,6 +10,7 @@ JSON text of an instance comes from :func:`~.json_format.instance_to_json`.
 
 from __future__ import annotations
 
+import errno
 import json
 import math
 import os
@@ -26,23 +27,39 @@ from .json_format import instance_to_json
 
 def replace_atomically(path: str | os.PathLike[str], write: Any) -> None:
     """Call ``write(tmp_path)`` on a temporary file beside ``path``, then move it into
-    place with ``os.replace``: an interrupted write never leaves a partial file."""
+    place with ``os.replace``: an interrupted write never leaves a partial file.
+
+    The temporary file is removed on any exception, Ctrl-C included (the CLI turns
+    SIGTERM / SIGHUP into the same unwinding; only SIGKILL can leave it behind), and
+    every error names ``path``, the user's own name, never the temporary one.
+    """
     path = Path(path)
     directory = path.parent if str(path.parent) else Path(".")
-    fd, tmp = tempfile.mkstemp(dir=directory, prefix=f".{path.stem}.", suffix=path.suffix)
-    os.close(fd)
+    if not directory.is_dir():
+        why = "is not a folder" if directory.exists() else "does not exist"
+        raise FileNotFoundError(errno.ENOENT, f"cannot write here: the folder {directory} "
+                                              f"{why}", str(path))
+    if path.is_dir():
+        raise IsADirectoryError(errno.EISDIR, "is a folder, not a file name", str(path))
+    tmp = None
     try:
+        fd, tmp = tempfile.mkstemp(dir=directory, prefix=f".{path.stem}.",
+                                   suffix=path.suffix)
+        os.close(fd)
         write(Path(tmp))
         umask = os.umask(0)
         os.umask(umask)
         os.chmod(tmp, 0o666 & ~umask)
         os.replace(tmp, path)
-    except BaseException:
-        try:
-            os.unlink(tmp)
-        except OSError:
-            pass
-        raise
+        tmp = None
+    except OSError as exc:
+        raise type(exc)(exc.errno, exc.strerror or str(exc), str(path)) from None
+    finally:
+        if tmp is not None:
+            try:
+                os.unlink(tmp)
+            except OSError:
+                pass
 
 
 def write_text_atomically(path: str | os.PathLike[str], text: str) -> None:

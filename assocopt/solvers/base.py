@@ -9,10 +9,12 @@ feasibility, timing) is done once, in :mod:`assocopt.api`, for every back end.
 
 from __future__ import annotations
 
+import dataclasses
 import functools
 import importlib.metadata
 import importlib.util
 import sys
+import time
 from dataclasses import dataclass, field
 from typing import Any, ClassVar
 
@@ -102,6 +104,15 @@ class RawResult:
     solve_time: float = 0.0
     solver: str = ""
     col_of_row: np.ndarray | None = None
+
+
+def remaining(options: SolveOptions, start: float) -> SolveOptions:
+    """``options`` with the time limit reduced by what has passed since ``start``
+    (``time.perf_counter()``): building a model counts against the limit too."""
+    if options.time_limit is None:
+        return options
+    left = max(options.time_limit - (time.perf_counter() - start), 1e-3)
+    return dataclasses.replace(options, time_limit=left)
 
 
 @functools.lru_cache(maxsize=None)

@@ -32,6 +32,10 @@ class _NodeLimit(Exception):
     pass
 
 
+class _OutOfTime(Exception):
+    pass
+
+
 def _candidate_masks(problem: AssignmentProblem) -> tuple[list[int], list[list[int]]]:
     """Bit mask of covered rows per candidate; candidates covering each row (in
     candidate order).  Straight from the tuple array: no scipy.sparse to import."""
@@ -47,9 +51,12 @@ def _candidate_masks(problem: AssignmentProblem) -> tuple[list[int], list[list[i
     return masks, by_row
 
 
-def enumerate_solutions(problem: AssignmentProblem, *,
-                        max_nodes: int = DEFAULT_MAX_NODES) -> Iterator[np.ndarray]:
+def enumerate_solutions(problem: AssignmentProblem, *, max_nodes: int = DEFAULT_MAX_NODES,
+                        deadline: float | None = None) -> Iterator[np.ndarray]:
     """Yield the candidate positions of every feasible solution, each exactly once.
+
+    ``deadline`` (a ``time.perf_counter()`` value) stops the search with
+    :class:`TimeoutError` when passed; the clock is read every 1024 nodes.
 
     Raises
     ------
@@ -83,6 +90,8 @@ def enumerate_solutions(problem: AssignmentProblem, *,
             nodes += 1
             if nodes > max_nodes:
                 raise _NodeLimit
+            if deadline is not None and not nodes & 1023 and time.perf_counter() > deadline:
+                raise _OutOfTime
             chosen.append(k)
             yield from search(covered | masks[k])
             chosen.pop()
@@ -94,6 +103,9 @@ def enumerate_solutions(problem: AssignmentProblem, *,
             f"brute force visited more than {max_nodes} nodes; the instance is too large "
             "for exhaustive enumeration (raise max_nodes or use an exact MIP back end)"
         ) from None
+    except _OutOfTime:
+        raise TimeoutError(f"brute force stopped by the time limit after {nodes} nodes") \
+            from None
 
 
 def count_solutions(problem: AssignmentProblem, *, max_nodes: int = DEFAULT_MAX_NODES) -> int:
@@ -113,6 +125,7 @@ class BruteForceBackend(Backend):
     description = "exhaustive enumeration of exact covers (tiny instances, test oracle)"
     options = (Option("max_nodes", "int", DEFAULT_MAX_NODES,
                       "search nodes; past them the search stops with time_limit", low=1),)
+    supports_time_limit = True
 
     own_method = True
 
@@ -121,15 +134,16 @@ class BruteForceBackend(Backend):
 
         max_nodes = self.settings(problem, options)["max_nodes"]
         t0 = time.perf_counter()
+        deadline = None if options.time_limit is None else t0 + options.time_limit
         best, best_cost, count = None, math.inf, 0
         costs = problem.costs
         try:
-            for sel in enumerate_solutions(problem, max_nodes=max_nodes):
+            for sel in enumerate_solutions(problem, max_nodes=max_nodes, deadline=deadline):
                 count += 1
                 cost = math.fsum(costs[sel].tolist())
                 if cost < best_cost:
                     best, best_cost = sel, cost
-        except ProblemTooLargeError as exc:
+        except (ProblemTooLargeError, TimeoutError) as exc:
             return RawResult(Status.TIME_LIMIT, selected=best, message=str(exc),
                              info={"solutions_seen": count},
                              solve_time=time.perf_counter() - t0)

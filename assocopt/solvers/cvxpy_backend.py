@@ -37,7 +37,9 @@ from ..errors import InvalidProblemError, SolverCapabilityError, SolverNotInstal
 from ..formulation import build_model
 from ..problem import AssignmentProblem
 from ..solution import Status, relative_gap
-from .base import Backend, Option, RawResult, SolveOptions, empty_answer, register
+from .base import (Backend, Option, RawResult, SolveOptions, empty_answer, register,
+                   remaining)
+from .interruptible import run_cancellable
 from .status import from_table, settle_optimal
 
 __all__ = ["CvxpyBackend"]
@@ -84,11 +86,15 @@ def _limit_options(solver: str, options: SolveOptions,
     gap_ = gap if is_mip else None
     if solver == "HIGHS":
         put("time_limit", opts, "time_limit", None if t is None else float(t))
+        if t is not None:       # HiGHS presolve ignores the clock (assocopt.solvers.highs)
+            opts["presolve"] = "off"
         put("mip_gap", opts, "mip_rel_gap", gap_)
         put("threads", opts, "threads", n)
     elif solver == "SCIPY":
         opts["scipy_options"] = nested
         put("time_limit", nested, "time_limit", None if t is None else float(t))
+        if t is not None:
+            nested["presolve"] = False
         put("mip_gap", nested, "mip_rel_gap", gap_)
     elif solver == "SCIP":
         opts["scip_params"] = nested
@@ -206,9 +212,13 @@ class CvxpyBackend(Backend):
                 data, chain, inverse = prob.get_problem_data(
                     solver=solver, verbose=bool(options.verbose), solver_opts=solver_opts)
                 t1 = time.perf_counter()
-                raw = chain.solve_via_data(prob, data, warm_start=False,
-                                           verbose=bool(options.verbose),
-                                           solver_opts=solver_opts)
+                # the solver gets what is left of the limit after CVXPY's compilation
+                limit_opts, passed = _limit_options(solver, remaining(options, t0), is_mip)
+                solver_opts = _merge(limit_opts, user_opts)
+                info["limits_passed"] = passed
+                # in a worker thread so that Ctrl-C takes effect at once (.interruptible)
+                raw, _ = run_cancellable(chain.solve_via_data, (prob, data), None, kwargs=dict(
+                    warm_start=False, verbose=bool(options.verbose), solver_opts=solver_opts))
                 prob.unpack_results(raw, chain, inverse)
         except cp.error.SolverError as exc:      # includes CVXPY's "solver_error" status
             t2 = time.perf_counter()

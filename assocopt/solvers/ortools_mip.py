@@ -36,7 +36,7 @@ from ..errors import InvalidProblemError, SolverNotInstalledError
 from ..formulation import build_model
 from ..problem import AssignmentProblem
 from ..solution import Status, relative_gap
-from .base import Backend, Option, RawResult, SolveOptions, register
+from .base import Backend, Option, RawResult, SolveOptions, register, remaining
 from .status import from_table, settle_optimal
 
 __all__ = ["OrtoolsMipBackend"]
@@ -181,8 +181,8 @@ class OrtoolsMipBackend(Backend):
                 helper.set_var_integrality(k, True)
         text, passed = _parameter_text(backend, options, is_mip, user_text)
         solver.enable_output(bool(options.verbose))
-        if options.time_limit is not None:
-            solver.set_time_limit_in_seconds(float(options.time_limit))
+        if options.time_limit is not None:       # what is left after building the model
+            solver.set_time_limit_in_seconds(float(remaining(options, t0).time_limit))
         if text:
             solver.set_solver_specific_parameters(text)
         t1 = time.perf_counter()
@@ -192,6 +192,8 @@ class OrtoolsMipBackend(Backend):
 
         native = solver.status().name
         detail = solver.status_string() if solver.has_response() else ""
+        if "SCIP status code 10" in detail:   # SCIP_STATUS_USERINTERRUPT: SCIP caught Ctrl-C
+            raise KeyboardInterrupt
         if native == "INVALID_SOLVER_PARAMETERS" and user_text:
             raise InvalidProblemError(
                 f"ortools-mip backend {backend!r} rejected the parameters {user_text!r}: "

@@ -14,7 +14,9 @@ import numpy as np
 from ..formulation import build_model
 from ..problem import AssignmentProblem
 from ..solution import Status
-from .base import Backend, Option, RawResult, SolveOptions, empty_answer, register
+from .base import (Backend, Option, RawResult, SolveOptions, empty_answer, register,
+                   remaining)
+from .interruptible import run_cancellable
 from .status import from_table, settle_optimal
 
 __all__ = ["ScipyMilpBackend"]
@@ -57,11 +59,16 @@ class ScipyMilpBackend(Backend):
         opts: dict[str, object] = {"disp": bool(options.verbose),
                                    "mip_rel_gap": float(options.mip_gap)}
         if options.time_limit is not None:
-            opts["time_limit"] = float(options.time_limit)
+            # HiGHS presolve ignores the clock (see assocopt.solvers.highs): off with a limit
+            opts["time_limit"] = float(remaining(options, t0).time_limit)
+            opts["presolve"] = False
         opts.update(extra)
         t1 = time.perf_counter()
-        res = milp(model.c, integrality=model.integrality, bounds=Bounds(model.lb, model.ub),
-                   constraints=constraint, options=opts)
+        # in a worker thread: scipy has no interrupt hook, but Ctrl-C then takes effect
+        # at once (the abandoned solve ends on its own, see .interruptible)
+        res, _ = run_cancellable(milp, (model.c,), None, kwargs=dict(
+            integrality=model.integrality, bounds=Bounds(model.lb, model.ub),
+            constraints=constraint, options=opts))
         t2 = time.perf_counter()
         gap = getattr(res, "mip_gap", None)
         status, _ = settle_optimal(from_table(_STATUS_TABLE, str(int(res.status))),

@@ -88,12 +88,17 @@ STOPPED = 1        # budget spent: incumbent (if any) and a bound
 INFEASIBLE = 2     # the kept axes admit no assignment
 
 
-@njit(cache=True)
+@njit(cache=True, nogil=True)
 def solve(G, pa, pb, c, relaxed, a, b, off_a, off_b, na, nb, plain, axis_of, ptr, lst,
           int_costs, tol, y0, max_iter, probe_every, probe_budget, budget,
           lam0, patience, lam_min, deflect, recover_every, n3, off_c, n_c, warm_start,
-          stall_tol):
+          stall_tol, stop):
     """Subgradient ascent on ``L(y)`` with periodic DFS probes, then a final DFS.
+
+    ``stop`` is a one-element array another thread may set non-zero (time limit,
+    Ctrl-C): the ascent checks it every iteration, the searches every 1024 nodes,
+    and the call returns ``STOPPED`` with its incumbent and bound.  Compiled with
+    ``nogil`` so that the caller can run it in a thread and keep the clock.
 
     Returns ``(outcome, best_sel, best_len, ub, bound, iterations, nodes)``.
     """
@@ -130,6 +135,8 @@ def solve(G, pa, pb, c, relaxed, a, b, off_a, off_b, na, nb, plain, axis_of, ptr
         idx3 = np.empty(0, np.int64)
     tmp_sel = np.empty(E + 1, np.int64)
     for it in range(1, max_iter + 1):
+        if stop[0] != 0:
+            return STOPPED, best_sel, best_len, ub, best_L, it, nodes
         ok, L = evaluate(G, pa, pb, c, relaxed, off_a, off_b, y, na, nb, plain, r,
                          yfull, chosen, vwarm, warm_start and it > 1)
         if not ok:
@@ -190,7 +197,7 @@ def solve(G, pa, pb, c, relaxed, a, b, off_a, off_b, na, nb, plain, axis_of, ptr
                                     improve_limit(ub, int_costs, tol) - base)
             out, ub, best_len, nn = dfs(G, c, rp, base, sptr, slst, axis_of, N,
                                         int_costs, tol, ub, best_sel, best_len,
-                                        probe_budget)
+                                        probe_budget, stop)
             nodes += nn
             if out == COMPLETE:
                 return PROVEN, best_sel, best_len, ub, best_L, it, nodes
@@ -211,7 +218,7 @@ def solve(G, pa, pb, c, relaxed, a, b, off_a, off_b, na, nb, plain, axis_of, ptr
     base = reduced(G, c, ybest, rp, ptr, lst, axis_of)
     sptr, slst = sort_lists(ptr, lst, rp, improve_limit(ub, int_costs, tol) - base)
     out, ub, best_len, nn = dfs(G, c, rp, base, sptr, slst, axis_of, N, int_costs, tol,
-                                ub, best_sel, best_len, budget)
+                                ub, best_sel, best_len, budget, stop)
     nodes += nn
     if out == COMPLETE:
         return PROVEN, best_sel, best_len, ub, best_L, it, nodes

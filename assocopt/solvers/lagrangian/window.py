@@ -104,10 +104,13 @@ def _compiled_search(problem: AssignmentProblem, pos: np.ndarray, red: np.ndarra
     kern.ensure(kern.sort_lists, ptr, lst, rp, limit - base)
     sptr, slst = kern.sort_lists(ptr, lst, rp, limit - base)
     best = np.full(problem.n_rows + 1, -1, np.int64)
+    from ..interruptible import new_stop, run_stoppable
+
+    stop = new_stop()
     args = (G, c, rp, base, sptr, slst, axis_of, problem.ndim, integer, OPT_TOL, cap,
-            best, -1, node_limit)
+            best, -1, node_limit, stop)
     kern.ensure(kern.dfs, *args)
-    out, _, n, _ = kern.dfs(*args)
+    (out, _, n, _), _ = run_stoppable(kern.dfs, args, stop, inline=node_limit <= 20_000)
     return (pos[best[:n]] if n > 0 else None), out == kern.COMPLETE
 
 
@@ -215,7 +218,7 @@ def _ilp(problem: AssignmentProblem, pos: np.ndarray, st: _State, options: Solve
     import highspy
 
     from ...formulation import LinearModel
-    from ..highs import highs_from_model
+    from ..highs import highs_from_model, run_highs
 
     K = len(pos)
     model = LinearModel(c=problem.costs[pos].astype(np.float64), A=_coverage(problem, pos),
@@ -233,7 +236,7 @@ def _ilp(problem: AssignmentProblem, pos: np.ndarray, st: _State, options: Solve
         x0.col_value = np.isin(pos, st.incumbent).astype(np.float64).tolist()
         x0.value_valid = True
         h.setSolution(x0)
-    h.run()
+    run_highs(h, deadline)            # a worker thread: Ctrl-C and the deadline stop it
     status = h.getModelStatus().name
     z = None
     if h.getInfo().primal_solution_status == 2:
@@ -277,7 +280,9 @@ def _cpsat(problem: AssignmentProblem, pos: np.ndarray, st: _State, options: Sol
     solver.parameters.log_search_progress = bool(options.verbose)
     if deadline is not None:
         solver.parameters.max_time_in_seconds = max(deadline - time.perf_counter(), 1e-3)
-    code = solver.Solve(m)
+    solver.parameters.catch_sigint_signal = False     # see solvers.ortools_cpsat
+    from ..interruptible import run_cancellable
+    code, _ = run_cancellable(solver.Solve, (m,), solver.stop_search)    # Ctrl-C at once
     z = None
     if code in (cp_model.OPTIMAL, cp_model.FEASIBLE):
         sel = pos[np.array([solver.BooleanValue(v) for v in x], bool)]
