@@ -42,7 +42,9 @@ class ScipyMilpBackend(Backend):
     lp = True
     supports_time_limit = True
     options = (
-        Option("presolve", "bool", True, "let HiGHS presolve the model"),
+        Option("presolve", "bool", None, "let HiGHS presolve the model (default: yes, "
+               "but no under a time limit: HiGHS presolve does not look at the clock)",
+               nullable=True),
         Option("node_limit", "int", None, "largest number of branch-and-bound nodes",
                low=1, nullable=True),
     )
