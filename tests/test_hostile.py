@@ -400,6 +400,28 @@ class TestTimeLimits:
         if sol.bound is not None and sol.objective is not None:
             assert sol.bound <= sol.objective
 
+    def test_highs_presolve_off_under_a_limit(self, hard_problem, monkeypatch):
+        """HiGHS presolve does not look at the clock (11 s under a 0.5 s limit on
+        Grundel n = 50): the HiGHS-based back ends switch it off under a limit only."""
+        import scipy.optimize
+
+        seen = []
+        real = scipy.optimize.milp
+
+        def spy(*args, options=None, **kw):
+            seen.append(dict(options or {}))
+            return real(*args, options=options, **kw)
+
+        monkeypatch.setattr(scipy.optimize, "milp", spy)
+        small = AssignmentProblem.dense(np.arange(9.0).reshape(3, 3))
+        solve(small, "scipy", time_limit=5.0)
+        solve(small, "scipy")
+        solve(small, "scipy", time_limit=5.0, presolve=True)
+        assert seen[0]["presolve"] is False and "presolve" not in seen[1]
+        assert seen[2]["presolve"] is True
+        assert solve(small, "highs", time_limit=5.0).info["presolve"] == "off"
+        assert solve(small, "highs").info["presolve"] != "off"
+
     def test_bruteforce_advertises_and_honours(self, hard_problem):
         assert registered()["bruteforce"].supports_time_limit
         sol = solve(hard_problem, "bruteforce", time_limit=0.2)
