@@ -144,10 +144,29 @@ SCALE_ABOVE = 2.0 ** 50
 _SCALE_TO_EXPONENT = 40
 
 
+def _max_abs_cost(problem: AssignmentProblem) -> float:
+    """Largest finite |cost|; for a dense 2-D problem read from its matrix (the
+    candidate list is not built for it)."""
+    d = problem.dense_view
+    arrays = [problem.costs] if d is None else [d.C, d.rm, d.cm]
+    m = 0.0
+    for a in arrays:
+        if a.size == 0:
+            continue
+        hi, lo = float(a.max()), float(a.min())
+        if not (math.isfinite(hi) and math.isfinite(lo)):
+            a = a[np.isfinite(a)]
+            if a.size == 0:
+                continue
+            hi, lo = float(a.max()), float(a.min())
+        m = max(m, hi, -lo)
+    return m
+
+
 def _solve_scaled(backend: Backend, problem: AssignmentProblem,
                   opts: SolveOptions) -> RawResult:
     """``backend.solve`` on ``problem`` with its costs scaled into a safe range if needed."""
-    amax = float(np.abs(problem.costs).max(initial=0.0))
+    amax = _max_abs_cost(problem)
     if amax <= SCALE_ABOVE:
         return backend.solve(problem, opts)
     shift = math.frexp(amax)[1] - _SCALE_TO_EXPONENT
