@@ -371,7 +371,9 @@ class TestInterrupts:
     def test_ctrl_c(self, hard_file, solver):
         if not registered()[solver].is_available():
             pytest.skip(f"{solver} not installed")
-        code, err = _interrupt(hard_file, solver)
+        code, err = _interrupt(hard_file, solver, after=1.0)
+        if code == 0:
+            pytest.skip(f"{solver} solved the instance before the interrupt arrived")
         lines = [ln for ln in err.strip().splitlines()
                  if not ln.startswith("assocopt: compiling")]
         assert code == 130, err
