@@ -30,6 +30,11 @@ def _kinds_for(name: str) -> tuple[str, ...]:
     return ("square", "rect", "miss") if registered()[name].max_ndim == 2 else KINDS
 
 
+#: back ends whose choice among equally good solutions may change from run to run
+#: (CP-SAT searches with several workers in parallel)
+TIES_MAY_DIFFER = {"ortools-cpsat"}
+
+
 @pytest.mark.parametrize("name", [installed(n) for n in ALL])
 def test_maximize_equals_minimising_the_negated_scores(name):
     integer = None if registered()[name].exact_float_costs else True
@@ -45,6 +50,12 @@ def test_maximize_equals_minimising_the_negated_scores(name):
             assert hi.objective is None
             return
         assert hi.objective == pytest.approx(-lo.objective, abs=1e-9)
+        # the same choice, up to ties: hi's tuples (same candidate order in q and p) cost
+        # lo's optimum under p's costs (multi-worker CP-SAT may break ties differently)
+        assert float(np.sum(p.costs[np.asarray(hi.selected)])) == pytest.approx(
+            lo.objective, abs=1e-9)
+        if name in TIES_MAY_DIFFER:
+            return
         assert sorted(map(tuple, hi.tuples.tolist())) == sorted(map(tuple, lo.tuples.tolist()))
         if lo.bound is not None:
             assert hi.bound == pytest.approx(-lo.bound, abs=1e-9)
