@@ -61,12 +61,12 @@ def _run(args: argparse.Namespace, out: TextIO, err: TextIO) -> int:
 
 
 def _exit_now_if_solver_threads(as_program: bool) -> None:
-    """After a Ctrl-C that stopped a solve running in a worker thread, leave at once:
-    native solver threads still winding down can make interpreter finalisation abort
-    (SIGABRT instead of exit 130).  Only when run as the program (``main()`` without
-    ``argv``), never inside a caller's process."""
-    mod = sys.modules.get("assocopt.solvers.interruptible")
-    if mod is None or not mod.INTERRUPTED.is_set() or not as_program:
+    """After a Ctrl-C, leave at once when run as the program (``main()`` without
+    ``argv``), never inside a caller's process: native solver threads still winding
+    down, or a compiler (numba/LLVM) interrupted half-way, can make interpreter
+    finalisation crash (SIGABRT or SIGSEGV instead of exit 130).  Files being written
+    were already cleaned up while the interrupt unwound to here."""
+    if not as_program:
         return
     import os
     for stream in (sys.stdout, sys.stderr):
