@@ -12,9 +12,11 @@ from assocopt.tracking.decide.topology import LARGE, trial_pairs
 
 
 def test_dynamic_schedule_follows_the_paper_examples():
-    r = IRRule()
+    r = IRRule(R_max=12)
     assert [r.criterion(k) for k in range(1, 9)] == list(DYNAMIC_SCHEDULE)
     assert r.criterion(12) == (10, 12)
+    assert [IRRule().criterion(k) for k in (1, 2, 3, 4, 5, 12)] == [(1, 1), (2, 2), (2, 3),
+                                                                  (3, 4), (3, 4), (3, 4)]
     assert IRRule("fixed", I=3, R=5).criterion(9) == (3, 5)
     with pytest.raises(ValueError, match="I <= R"):
         IRRule("fixed", I=4, R=3)

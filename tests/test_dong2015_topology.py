@@ -116,7 +116,7 @@ def test_heading_variance_and_jacobian_against_finite_differences():
     assert np.allclose(J, num, rtol=1e-5, atol=1e-6)
 
 
-OPTIONS = [{}, {"assignment": "rectangular"}, {"frame": "full"}, {"inflate": True},
+OPTIONS = [{}, {"degree": "objective"}, {"ref_cov": True, "frame": "full"}, {"ref_cov": True, "inflate": True}, {"assignment": "rectangular"}, {"frame": "full"}, {"inflate": True},
            {"metric": "euclidean"}, {"threshold": "heading", "coef": 50.0},
            {"min_pairs": 3}, {"assignment": "rectangular", "metric": "euclidean"}]
 

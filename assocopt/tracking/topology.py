@@ -79,18 +79,28 @@ def _offsets(X: np.ndarray, full_state: bool) -> np.ndarray:
     return X[None, :, :] - ref[:, None, :]
 
 
-def reference_frames(X: ArrayLike, P: ArrayLike, full_state: bool = False
-                     ) -> tuple[np.ndarray, np.ndarray]:
+def reference_frames(X: ArrayLike, P: ArrayLike, full_state: bool = False,
+                     ref_cov: bool = False) -> tuple[np.ndarray, np.ndarray]:
     """Every track in every reference track's frame.
 
     Returns ``Xr[u, i] = T(u) (X_i - E X_u)`` (shape ``(n, n, 4)``) and
     ``Pr[u, i] = T(u) P_i T(u)^T`` (shape ``(n, n, 4, 4)``).  ``full_state`` subtracts
-    the whole reference state instead of its position only.
+    the whole reference state instead of its position only.  ``ref_cov`` (ours) uses
+    the first-order covariance of ``X_i - E X_u`` instead: ``P_i + E P_u E^T`` for
+    ``i != u`` (independent track errors); the reference's own entry keeps
+    ``T P_u T^T`` as without it (its exact covariance is singular).
     """
     X, P = check_tracks(X, P)
     T = rotations(headings(X))
     Xr = np.einsum("uab,uib->uia", T, _offsets(X, full_state))
-    Pr = np.einsum("uab,ibc,udc->uiad", T, P, T)
+    if ref_cov:
+        E = np.eye(4) if full_state else np.diag([1.0, 1.0, 0.0, 0.0])
+        Q = P[None, :] + (E @ P @ E)[:, None]
+        n = len(X)
+        Q[np.arange(n), np.arange(n)] = P
+        Pr = np.einsum("uab,uibc,udc->uiad", T, Q, T)
+    else:
+        Pr = np.einsum("uab,ibc,udc->uiad", T, P, T)
     return Xr, Pr
 
 

@@ -148,14 +148,17 @@ def _gated_matching(G, t, rows, cols, A):
 
 @njit(cache=True)
 def phi_kernel(X1r, P1r, X2r, P2r, J1, var1, J2, var2, inflate, euclid, thr, dummy,
-               exclude_ref, min_pairs, active, large):
+               exclude_ref, min_pairs, active, large, objective):
     """``(phi, M)``: lambda_uv and the number of confirmed pairs for every (u, v).
 
     Per pair: the rectangular assignment (``dummy`` False: the smaller side assigned
     completely, the matrix padded with zero rows or columns), or the assignment with a
     dummy per row and column at half the gate (``dummy`` True), solved over the gated
     entries only; then the assigned pairs with ``gamma <= t`` are confirmed.  Pairs
-    with ``active`` False are skipped (``large``, 0).
+    with ``active`` False are skipped (``large``, 0).  ``objective``: lambda is the
+    assignment's cost per track with every unconfirmed track at the gate,
+    ``(sum of confirmed gamma + (N - M) t) / N``, ``N = min(n1, n2)`` (less the
+    reference pair when it is left out), instead of the mean over the confirmed pairs.
     """
     n1 = X1r.shape[1]
     n2 = X2r.shape[1]
@@ -195,5 +198,9 @@ def phi_kernel(X1r, P1r, X2r, P2r, J1, var1, J2, var2, inflate, euclid, thr, dum
                     m += 1
             M[u, v] = m
             if m > 0 and m >= min_pairs:
-                phi[u, v] = s / m
+                if objective:
+                    nn = min(n1, n2) - (1 if exclude_ref else 0)
+                    phi[u, v] = (s + (nn - m) * t) / nn
+                else:
+                    phi[u, v] = s / m
     return phi, M

@@ -12,8 +12,9 @@ smallest index.
 Criteria (:class:`IRRule`):
 
 ``"dynamic"``  (ours, from the paper's example list 1/1, 2/2, 2/3, 3/4, 3/5, 4/6, 5/7,
-               6/8, ...): at step k the window is every step so far (R = k) and I is
-               the list's entry for that R, then I = k - 2; every step has a decision.
+               6/8, ...): at step k the window is every step so far up to ``R_max``
+               (R = min(k, R_max)) and I is the list's entry for that R (I = R - 2
+               beyond the list); the window then slides.  Every step has a decision.
 ``"fixed"``    one I/R with a sliding window of the last R steps (whether the paper's
                window slides is not said); nothing is confirmed before step I.
 
@@ -48,20 +49,24 @@ class IRRule:
     I: int = 2
     R: int = 3
     exclusive: bool = False
+    R_max: int = 4
 
     def __post_init__(self) -> None:
         if self.schedule not in ("dynamic", "fixed"):
             raise ValueError(f"schedule must be 'dynamic' or 'fixed', got {self.schedule!r}")
         if not (isinstance(self.I, int) and isinstance(self.R, int) and 1 <= self.I <= self.R):
             raise ValueError(f"need integers 1 <= I <= R, got I={self.I!r}, R={self.R!r}")
+        if not isinstance(self.R_max, int) or self.R_max < 1:
+            raise ValueError(f"R_max must be a positive integer, got {self.R_max!r}")
 
     def criterion(self, k: int) -> tuple[int, int]:
         """(I, R) at step ``k`` (1-based)."""
         if self.schedule == "fixed":
             return self.I, self.R
-        if k <= len(DYNAMIC_SCHEDULE):
-            return DYNAMIC_SCHEDULE[k - 1]
-        return k - 2, k
+        R = min(k, self.R_max)
+        if R <= len(DYNAMIC_SCHEDULE):
+            return DYNAMIC_SCHEDULE[R - 1]
+        return R - 2, R
 
     def as_dict(self) -> dict[str, Any]:
         return asdict(self)

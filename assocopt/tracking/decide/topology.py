@@ -27,6 +27,12 @@ Options (:class:`TopologyParams`; every reading not fixed by the paper is named)
                 ``"rectangular"`` (the smaller side fully assigned, then gated; every
                 pair needs a full n x n Hungarian, about 15x slower at 30 targets);
 ``inflate``     add the reference headings' variance to B (ours);
+``ref_cov``     first-order covariance of the offsets from the reference: adds the
+                reference's own position covariance (ours; the paper rotates P_i only);
+``degree``      ``"mean"`` (the paper's lambda: mean gamma over the confirmed pairs) or
+                ``"objective"`` (ours: the assignment cost per track with every
+                unconfirmed track at the gate, so a pair confirming few neighbours can
+                no longer beat one confirming many);
 ``threshold``   ``"chi2"`` (gate delta(alpha, 4), or ``euclid_gate_m^2``) or
                 ``"heading"``: our substitute for the paper's lost threshold T_1,
                 ``gate * (1 + coef * (var(theta_1u) + var(theta_2v)))`` (flagged as ours).
@@ -59,6 +65,8 @@ class TopologyParams:
     frame: str = "position"
     assignment: str = "dummy"
     inflate: bool = False
+    ref_cov: bool = False
+    degree: str = "mean"
     threshold: str = "chi2"
     coef: float = 20.0
     alpha: float = 0.01
@@ -69,7 +77,8 @@ class TopologyParams:
         for name, valid in (("metric", ("statistical", "euclidean")),
                             ("frame", ("position", "full")),
                             ("assignment", ("rectangular", "dummy")),
-                            ("threshold", ("chi2", "heading"))):
+                            ("threshold", ("chi2", "heading")),
+                            ("degree", ("mean", "objective"))):
             if getattr(self, name) not in valid:
                 raise ValueError(f"{name} must be one of {valid}, got {getattr(self, name)!r}")
         if self.coef < 0 or self.euclid_gate_m <= 0:
@@ -106,8 +115,8 @@ def prepare(X1, P1, X2, P2, params: TopologyParams) -> StepInputs:
     X1, P1 = check_tracks(X1, P1, "sensor 1")
     X2, P2 = check_tracks(X2, P2, "sensor 2")
     full = params.frame == "full"
-    X1r, P1r = reference_frames(X1, P1, full)
-    X2r, P2r = reference_frames(X2, P2, full)
+    X1r, P1r = reference_frames(X1, P1, full, params.ref_cov)
+    X2r, P2r = reference_frames(X2, P2, full, params.ref_cov)
     return StepInputs(X1r, P1r, X2r, P2r, heading_jacobians(X1, full),
                       heading_jacobians(X2, full), heading_variance(X1, P1),
                       heading_variance(X2, P2))
@@ -139,7 +148,7 @@ def phi_matrix(inp: StepInputs, params: TopologyParams,
     return phi_kernel(inp.X1r, inp.P1r, inp.X2r, inp.P2r, inp.J1, v1, inp.J2, v2,
                       params.inflate, params.metric == "euclidean", thresholds(inp, params),
                       params.assignment == "dummy", params.frame == "full",
-                      params.min_pairs, act, LARGE)
+                      params.min_pairs, act, LARGE, params.degree == "objective")
 
 
 def pair_gammas(inp: StepInputs, params: TopologyParams, u: int, v: int) -> np.ndarray:
@@ -181,6 +190,9 @@ def phi_reference(inp: StepInputs, params: TopologyParams, solver: str = "auto",
             M[u, v] = int(ok.sum())
             if M[u, v] >= params.min_pairs:
                 phi[u, v] = float(G[rows, cols][ok].mean())
+                if params.degree == "objective":
+                    nn = min(n1, n2) - (params.frame == "full")
+                    phi[u, v] = (float(G[rows, cols][ok].sum()) + (nn - M[u, v]) * t) / nn
     return phi, M
 
 
