@@ -22,7 +22,8 @@ trial pairs, then the double-threshold rule over the steps):
 ``ted``          the Euclidean baseline: squared distance of the positions in the
                  reference frames, gate ``euclid_gate_m`` (ours: the paper's Euclidean
                  coefficient is lost), otherwise as ``tsd``; ``ted-obj`` with our
-                 objective degree; ``ted-t1`` with the substitute threshold.
+                 objective degree; ``ted-t1`` with the substitute threshold;
+``tsd-obj-t1``, ``ted-obj-t1`` the objective degree with the substitute threshold.
 
 Position baselines on the biased tracks (each step on its own, no I/R):
 ``nn`` (each sensor-1 track its nearest sensor-2 track in Mahalanobis distance of the
@@ -70,6 +71,8 @@ METHODS: dict[str, dict[str, Any]] = {
     "ted": {"metric": "euclidean"},
     "ted-obj": {"metric": "euclidean", "degree": "objective"},
     "ted-t1": {"metric": "euclidean", "threshold": "heading"},
+    "tsd-obj-t1": {"degree": "objective", "threshold": "heading"},
+    "ted-obj-t1": {"metric": "euclidean", "degree": "objective", "threshold": "heading"},
     "nn": {"rule": "nn"},
     "gnn": {"rule": "gnn"},
 }
