@@ -116,12 +116,18 @@ def test_heading_variance_and_jacobian_against_finite_differences():
     assert np.allclose(J, num, rtol=1e-5, atol=1e-6)
 
 
-OPTIONS = [{}, {"degree": "objective"}, {"ref_cov": True, "frame": "full"}, {"ref_cov": True, "inflate": True}, {"assignment": "rectangular"}, {"frame": "full"}, {"inflate": True},
+OPTIONS = [{}, {"degree": "objective"}, {"ref_cov": True, "frame": "full"},
+           {"ref_cov": True, "inflate": True}, {"assignment": "rectangular"},
+           {"frame": "full"}, {"inflate": True},
            {"metric": "euclidean"}, {"threshold": "heading", "coef": 50.0},
            {"min_pairs": 3}, {"assignment": "rectangular", "metric": "euclidean"}]
 
 
-@pytest.mark.parametrize("kw", OPTIONS, ids=lambda kw: ",".join(f"{k}={v}" for k, v in kw.items()) or "default")
+def _option_id(kw) -> str:
+    return ",".join(f"{k}={v}" for k, v in kw.items()) or "default"
+
+
+@pytest.mark.parametrize("kw", OPTIONS, ids=_option_id)
 @pytest.mark.parametrize("seed", [5, 6])
 def test_compiled_phi_agrees_with_solve_one_pair_at_a_time(kw, seed):
     rng = np.random.default_rng(seed)

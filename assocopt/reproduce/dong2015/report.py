@@ -235,9 +235,19 @@ def render_headline(summary: Mapping[str, Any]) -> str:
                  f"{_ci(_one(hd, 'tsd', 2), 3)} rad, sensor 2 {_ci(_one(hd2, 'tsd', 2), 3)} rad")
     t = lookup(recs, "main", "t_step_ms")
     if t and _one(t, "tsd-c", 2):
-        L.append(f"- time per step, 30 targets, env 2: TSD corrected "
+        L.append(f"- time per step, 30 targets, env 2, mean over the 12 steps: TSD corrected "
                  f"{_ci(_one(t, 'tsd-c', 2), 1)} ms, with pre-gate "
                  f"{_ci(_one(t, 'tsd-c-pregate', 2), 1)} ms")
+    pf = lookup(recs, "main", "pairs_frac")
+    if pf and _one(pf, "tsd-c-pregate", 2):
+        L.append(f"- the speed pre-gate keeps {_ci(_one(pf, 'tsd-c-pregate', 2))} of the "
+                 f"reference pairs in env 2 ({_ci(_one(pf, 'tsd-c-pregate', 3))} in env 3)")
+    lp = {r["n_targets"]: r for r in summary.get("lap_paths", [])}
+    if 30 in lp:
+        r = lp[30]
+        L.append(f"- one converged step (the last), 30 targets: {r['compiled_ms']:.1f} ms "
+                 f"compiled with dummies, {r['compiled_rect_ms']:.1f} ms rectangular, "
+                 f"{r.get('solve_ms', float('nan')):.0f} ms through `assocopt.solve`")
     if "wall_s" in summary:
         L.append(f"- wall time of the full run: {summary['wall_s']:.0f} s with "
                  f"{summary['workers']} worker process(es)")

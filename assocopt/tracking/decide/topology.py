@@ -48,7 +48,7 @@ import numpy as np
 from ...api import solve
 from ...problem import AssignmentProblem
 from ..topology import (check_tracks, chi2_gate, heading_jacobians, heading_variance,
-                        headings, pair_distances, reference_frames)
+                        pair_distances, reference_frames)
 
 __all__ = ["TopologyParams", "StepInputs", "prepare", "phi_matrix", "phi_reference",
            "coarse_pregate", "trial_pairs", "LARGE"]
@@ -252,8 +252,3 @@ def trial_pairs(phi: np.ndarray, rule: str = "row", solver: str = "auto") -> np.
                        solver).assignment()
     out[rows] = cols
     return out
-
-
-def headings_of(X) -> np.ndarray:
-    """Heading of each track (re-exported for the pre-gate's turn rate)."""
-    return headings(X)

@@ -68,7 +68,8 @@ class Run:
 
     @property
     def n_common(self) -> int:
-        return len(set(self.ids1[self.ids1 >= 0].tolist()) & set(self.ids2[self.ids2 >= 0].tolist()))
+        real1, real2 = self.ids1[self.ids1 >= 0], self.ids2[self.ids2 >= 0]
+        return len(set(real1.tolist()) & set(real2.tolist()))
 
     @property
     def common_observation_rate(self) -> float:
@@ -145,7 +146,8 @@ class Dong2015:
         """Converted measurements ``(K, n, 2)`` and covariances ``(K, n, 2, 2)``."""
         origin = np.array([0.0, 0.0]) if s == 0 else np.array([self.sensor2_x, 0.0])
         d = X[..., :2] - origin
-        r = np.hypot(d[..., 0], d[..., 1]) + self.bias_r[s] + rng.normal(0, self.sigma_r, d.shape[:-1])
+        r = (np.hypot(d[..., 0], d[..., 1]) + self.bias_r[s]
+             + rng.normal(0, self.sigma_r, d.shape[:-1]))
         sa = math.radians(self.sigma_az_deg)
         az = (np.arctan2(d[..., 0], d[..., 1]) + math.radians(self.bias_az_deg[s])
               + rng.normal(0, sa, d.shape[:-1]))
