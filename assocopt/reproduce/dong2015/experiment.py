@@ -83,8 +83,8 @@ LABELS = {
     "tsd-c": "TSD corrected (ours)", "tsd-c-pregate": "TSD corrected + pre-gate (ours)",
     "tsd-c-global": "TSD corrected, global trial pairs (ours)",
     "ted": "TED (Euclidean) as reconstructed", "ted-obj": "TED, objective degree (ours)",
-    "ted-t1": "TED + T_1 substitute (ours)", "tsd-obj-t1": "TSD objective + T_1 substitute",
-    "ted-obj-t1": "TED objective + T_1 substitute",
+    "ted-t1": "TED + T_1 substitute (ours)", "tsd-obj-t1": "TSD objective + T_1 substitute (ours)",
+    "ted-obj-t1": "TED objective + T_1 substitute (ours)",
     "nn": "NN on biased tracks", "gnn": "GNN (2-D assignment) on biased tracks",
 }
 VOLATILE = ("t_step_ms",)
