@@ -50,7 +50,8 @@ from ...problem import AssignmentProblem
 from ..topology import (check_tracks, chi2_gate, heading_jacobians, heading_variance,
                         pair_distances, reference_frames)
 
-__all__ = ["TopologyParams", "StepInputs", "prepare", "phi_matrix", "phi_reference",
+__all__ = ["TopologyParams", "StepInputs", "prepare", "thresholds", "pair_gammas",
+           "phi_matrix", "phi_reference",
            "coarse_pregate", "trial_pairs", "LARGE"]
 
 #: "A sufficiently large value" of lambda_uv when (u, v) has no confirmed pair.
