@@ -158,7 +158,7 @@ def _timing_tables(summary) -> list[str]:
               "one pair at a time | of which the assignments in solve | the same "
               "assignments in scipy lsa | same Phi |", "|---|---|---|---|---|---|---|"]
         for r in lp:
-            f = lambda key: f"{r[key]:.0f}" if key in r else "—"
+            f = lambda key: f"{r[key]:.1f}" if key in r else "—"
             agree = ("yes" if r["agree"] else "NO") if "agree" in r else "—"
             L.append(f"| {r['n_targets']} | {r['compiled_ms']:.1f} | "
                      f"{r['compiled_rect_ms']:.1f} | {f('solve_ms')} | {f('solve_only_ms')} | "
