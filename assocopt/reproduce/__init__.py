@@ -19,7 +19,7 @@ from pathlib import Path
 from typing import Any, Callable, Mapping
 
 from ..errors import AssocoptError
-from . import lu2013, xue1999, yan2010, zhang2009
+from . import dong2015, lu2013, xue1999, yan2010, zhang2009
 
 __all__ = ["PAPERS", "Paper", "list_papers", "reproduce", "run"]
 
@@ -54,6 +54,10 @@ PAPERS: dict[str, Paper] = {
                      "Yan et al. 2010, multi-feature D-S track-to-track association for "
                      "passive TDOA systems: Table 1, Fig. 4",
                      100, yan2010.run, "docs/papers/yan2010.md"),
+    "dong2015": Paper("dong2015", "004",
+                      "Dong et al. 2015, anti-bias track association by topology statistical "
+                      "distance: Figs. 2-7, time per step in place of Table 1",
+                      50, dong2015.run, "docs/papers/dong2015.md"),
 }
 
 

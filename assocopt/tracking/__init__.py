@@ -4,6 +4,7 @@
 * :mod:`.costs` -- S-D cost builders (Pattipati's likelihood ratio, KLD/SKLD);
 * :mod:`.belief` -- belief (mass) functions and combination rules;
 * :mod:`.group_matching` -- matching measures between two sensors' group observations;
+* :mod:`.topology` -- target reference frames and the topology statistical distance;
 * :mod:`.decide` -- decision rules (MD-ND truncation, MD-2DA);
 * :mod:`.scenarios` -- the simulated scenarios of the papers (Lu 2013, Zhang 2009);
 * :mod:`.gating` -- chi-square gating of track-measurement pairs (KD-tree pre-filter);

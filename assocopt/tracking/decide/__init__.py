@@ -7,7 +7,9 @@
 * :mod:`.nearest` -- report-to-track GNN (a 2-D assignment through ``solve``) and
   nearest neighbour;
 * :mod:`.max_degree` -- paper 001's maximum-degree rule, association-quality counter,
-  its 2-D assignment counterpart and the weighted chi-square baseline.
+  its 2-D assignment counterpart and the weighted chi-square baseline;
+* :mod:`.topology` -- paper 004's 2-D assignment per reference pair, the degree
+  matrix Phi and the trial pairs; :mod:`.double_threshold` -- its I/R confirmation.
 """
 
 from .md2da import MD2DAResult, gate_threshold, md_2da, md_2da_problem

@@ -1,0 +1,169 @@
+"""The association methods compared on paper 004's scenario, run over the steps of a
+simulated run, and the metrics (defined once here; the page repeats them).
+
+Topology methods (per step: Phi by :func:`~assocopt.tracking.decide.topology.phi_matrix`,
+trial pairs, then the double-threshold rule over the steps):
+
+``tsd``          the topology statistical distance as reconstructed: positions
+                 translated, velocities rotated, dummies at the gate, chi-square gate
+                 delta(0.01, 4), row-wise trial pairs, dynamic I/R;
+``tsd-t1``       the same with our substitute for the lost heading threshold T_1
+                 (``coef`` = the threshold coefficient; 20 as the paper's C_1);
+``tsd-full``     full-state frame, reference pair left out of lambda;
+``tsd-rect``     rectangular assignment, then gate;
+``tsd-global``   trial pairs by a global 2-D assignment on Phi;
+``tsd-min5``     lambda only from at least 5 confirmed pairs;
+``tsd-obj``      lambda = the assignment cost per track, unconfirmed tracks at the
+                 gate (ours);
+``tsd-inflate``  ``tsd-obj`` with the reference-heading variance added to B (ours);
+``tsd-c``        ``tsd-inflate`` with the reference's position covariance added
+                 (ours: all three corrections); ``tsd-c-pregate`` with the coarse
+                 speed pre-gate, ``tsd-c-global`` with global trial pairs;
+``ted``          the Euclidean baseline: squared distance of the positions in the
+                 reference frames, gate ``euclid_gate_m`` (ours: the paper's Euclidean
+                 coefficient is lost), otherwise as ``tsd``; ``ted-obj`` with our
+                 objective degree; ``ted-t1`` with the substitute threshold;
+``tsd-obj-t1``, ``ted-obj-t1`` the objective degree with the substitute threshold.
+
+Position baselines on the biased tracks (each step on its own, no I/R):
+``nn`` (each sensor-1 track its nearest sensor-2 track in Mahalanobis distance of the
+full state under the gate) and ``gnn`` (the 2-D assignment of the same costs with the
+gate as non-assignment cost, through :func:`assocopt.solve`).
+
+Metrics per step k: ``ec_kNN`` = correct pairs / common targets (the paper's E_c),
+``fp_kNN`` = wrong pairs / common targets; ``ec_mean``; ``t_step_ms`` (volatile);
+``pairs_frac``: fraction of reference pairs evaluated (pre-gate); heading errors
+``hd1_kNN``, ``hd2_kNN`` (mean absolute, rad, every real target) and ``hd1t0_kNN``,
+``hd2t0_kNN`` (the first common target, as the paper's Fig. 2), with method ``tsd``.
+"""
+
+from __future__ import annotations
+
+import math
+import time
+from typing import Any, Mapping
+
+import numpy as np
+
+from ..decide.double_threshold import DoubleThreshold, IRRule
+from ..decide.nearest import gnn_assign, nearest_neighbour
+from ..decide.topology import (TopologyParams, coarse_pregate, phi_matrix, prepare,
+                               trial_pairs)
+from ..topology import chi2_gate, headings
+from .dong2015 import Run
+
+__all__ = ["METHODS", "run_method", "position_costs", "step_metrics"]
+
+METHODS: dict[str, dict[str, Any]] = {
+    "tsd": {},
+    "tsd-t1": {"threshold": "heading"},
+    "tsd-full": {"frame": "full"},
+    "tsd-rect": {"assignment": "rectangular"},
+    "tsd-global": {"trial": "assignment"},
+    "tsd-min5": {"min_pairs": 5},
+    "tsd-obj": {"degree": "objective"},
+    "tsd-inflate": {"degree": "objective", "inflate": True},
+    "tsd-c": {"degree": "objective", "inflate": True, "ref_cov": True},
+    "tsd-c-pregate": {"degree": "objective", "inflate": True, "ref_cov": True,
+                      "pregate": True},
+    "tsd-c-global": {"degree": "objective", "inflate": True, "ref_cov": True,
+                     "trial": "assignment"},
+    "ted": {"metric": "euclidean"},
+    "ted-obj": {"metric": "euclidean", "degree": "objective"},
+    "ted-t1": {"metric": "euclidean", "threshold": "heading"},
+    "tsd-obj-t1": {"degree": "objective", "threshold": "heading"},
+    "ted-obj-t1": {"metric": "euclidean", "degree": "objective", "threshold": "heading"},
+    "nn": {"rule": "nn"},
+    "gnn": {"rule": "gnn"},
+}
+_TOPO_KEYS = ("metric", "frame", "assignment", "inflate", "ref_cov", "degree", "threshold",
+              "min_pairs")
+
+
+def position_costs(X1, P1, X2, P2) -> np.ndarray:
+    """Mahalanobis distance of the full states on the biased tracks, ``(n1, n2)``."""
+    D = X1[:, None, :] - X2[None, :, :]
+    B = P1[:, None] + P2[None, :]
+    return np.einsum("ija,ija->ij", D, np.linalg.solve(B, D[..., None])[..., 0])
+
+
+def step_metrics(partner: np.ndarray, truth: np.ndarray, n_common: int) -> tuple[float, float]:
+    """(E_c, wrong pairs per common target) of one step's decided pairs."""
+    ok = partner >= 0
+    correct = int(np.sum(ok & (partner == truth)))
+    wrong = int(np.sum(ok)) - correct
+    if n_common == 0:
+        return math.nan, math.nan
+    return correct / n_common, wrong / n_common
+
+
+def _params(opts: Mapping[str, Any], setting: Mapping[str, Any]) -> TopologyParams:
+    kw = {k: opts[k] for k in _TOPO_KEYS if k in opts}
+    return TopologyParams(alpha=float(setting.get("alpha", 0.01)),
+                          coef=float(setting.get("coef", 20.0)),
+                          euclid_gate_m=float(setting.get("euclid_gate_m", 1000.0)), **kw)
+
+
+def run_method(run: Run, method: str, setting: Mapping[str, Any] | None = None
+               ) -> dict[str, float]:
+    """Associate every step of ``run`` with ``method``; the metrics of the run."""
+    if method not in METHODS:
+        raise ValueError(f"unknown dong2015 method {method!r}; valid: {sorted(METHODS)}")
+    setting = dict(setting or {})
+    opts = METHODS[method]
+    truth = run.truth_partner()
+    n_common = run.n_common
+    n1, n2 = len(run.ids1), len(run.ids2)
+    out: dict[str, float] = {}
+    dt = DoubleThreshold(n1, n2, IRRule(setting.get("ir_schedule", "dynamic"),
+                                        I=int(setting.get("ir_I", 2)),
+                                        R=int(setting.get("ir_R", 3)),
+                                        R_max=int(setting.get("ir_R_max", 4))))
+    p = None if "rule" in opts else _params(opts, setting)
+    gate = chi2_gate(float(setting.get("alpha", 0.01)), 4)
+    t_total, evaluated = 0.0, 0
+    for k, st in enumerate(run.steps, start=1):
+        t0 = time.perf_counter()
+        if opts.get("rule") == "nn":
+            C = position_costs(st.X1, st.P1, st.X2, st.P2)
+            partner = nearest_neighbour(C.T, gate)
+        elif opts.get("rule") == "gnn":
+            C = position_costs(st.X1, st.P1, st.X2, st.P2)
+            partner = gnn_assign(C, gate)
+        else:
+            active = None
+            if opts.get("pregate"):
+                active = coarse_pregate(st.X1, st.P1, st.X2, st.P2,
+                                        float(setting.get("pregate_alpha", 0.01)))
+                evaluated += int(active.sum())
+            else:
+                evaluated += n1 * n2
+            phi, _ = phi_matrix(prepare(st.X1, st.P1, st.X2, st.P2, p), p, active)
+            partner = dt.update(trial_pairs(phi, opts.get("trial", "row")), phi)
+        t_total += time.perf_counter() - t0
+        ec, fp = step_metrics(partner, truth, n_common)
+        out[f"ec_k{k:02d}"], out[f"fp_k{k:02d}"] = ec, fp
+    K = len(run.steps)
+    out["ec_mean"] = float(np.mean([out[f"ec_k{k:02d}"] for k in range(1, K + 1)]))
+    out["t_step_ms"] = 1e3 * t_total / K
+    if p is not None:
+        out["pairs_frac"] = evaluated / (K * n1 * n2) if n1 * n2 else math.nan
+    if method == "tsd":
+        out.update(heading_errors(run))
+    return out
+
+
+def heading_errors(run: Run) -> dict[str, float]:
+    """Mean absolute heading error per step and sensor (rad), all real targets and the
+    first common target."""
+    out = {}
+    common = sorted(set(run.ids1[run.ids1 >= 0].tolist()) & set(run.ids2[run.ids2 >= 0].tolist()))
+    t0 = common[0] if common else None
+    for k, st in enumerate(run.steps, start=1):
+        for s, (X, ids, th) in enumerate(((st.X1, run.ids1, run.true_heading1),
+                                          (st.X2, run.ids2, run.true_heading2)), start=1):
+            e = np.abs((headings(X) - th[k - 1] + math.pi) % (2 * math.pi) - math.pi)
+            out[f"hd{s}_k{k:02d}"] = float(np.nanmean(e))
+            if t0 is not None:
+                out[f"hd{s}t0_k{k:02d}"] = float(e[ids == t0][0])
+    return out
