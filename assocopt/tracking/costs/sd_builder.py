@@ -42,14 +42,24 @@ __all__ = ["Scan", "COSTS", "PRINTED_COSTS", "candidate_tuples", "TupleGeometry"
 #: sensor's [alpha, beta] pair, without (26).
 COSTS: dict[str, str] = {
     "pattipati": "eq. (7): 1/2 Delta^T R^-1 Delta with the LS position (ref. [2] of paper 002)",
-    "kld-printed": "eqs. (24)+(26)+(27) exactly as printed (not a KL divergence)",
-    "skld-printed": "eqs. (25)+(26)+(28) exactly as printed (not the symmetric KL)",
-    "kld-exact": "eqs. (24)+(26) with the exact 1-D Gaussian KL divergence",
-    "skld-exact": "eqs. (25)+(26) with the exact 1-D symmetric KL divergence",
+    "kld-printed": "eqs. (24)+(26)+(27) exactly as printed (not a KL divergence: negative "
+                   "when s~ < s)",
+    "skld-printed": "eqs. (25)+(26)+(28) exactly as printed (not the symmetric KL: no "
+                    "variance term)",
+    "kld-exact": "eqs. (24)+(26) with the exact 1-D Gaussian KL divergence "
+                 "KL(pseudo-measurement || measurement)",
+    "skld-exact": "eqs. (25)+(26) with the exact 1-D symmetric KL (Jeffreys) divergence",
     "kld-joint": "eq. (24) with the exact 2-D Gaussian KL of each sensor's (alpha, beta)",
     "skld-joint": "eq. (25) with the exact 2-D Gaussian symmetric KL of each sensor's "
                   "(alpha, beta)",
+    "pattipati-ml": "eq. (7) with the maximum-likelihood position (iterated LS, Gauss-Newton) "
+                    "instead of the one-step LS (14)",
+    "kld-reversed": "eqs. (24)+(26) with the exact 1-D KL divergence, arguments swapped: "
+                    "KL(measurement || pseudo-measurement), mean difference weighted by "
+                    "1/s~^2",
 }
+#: Costs that localise with their own method, whatever the run's ``localiser``.
+COST_LOCALISER: dict[str, str] = {"pattipati-ml": "ils"}
 #: The costs as the paper prints them (what its tables report).
 PRINTED_COSTS = ("pattipati", "kld-printed", "skld-printed")
 
@@ -301,7 +311,7 @@ def _data_term(g: TupleGeometry, method: str) -> np.ndarray:
     c = _components(g)
     da, db, ra, rb, rab = c["da"], c["db"], c["ra"], c["rb"], c["rab"]
     with np.errstate(invalid="ignore", divide="ignore", over="ignore"):
-        if method == "pattipati":
+        if method in ("pattipati", "pattipati-ml"):
             det_r = ra * rb - rab * rab
             per = (rb * da * da - 2.0 * rab * da * db + ra * db * db) / det_r
         elif method.endswith("-joint"):
@@ -318,9 +328,13 @@ def _data_term(g: TupleGeometry, method: str) -> np.ndarray:
                 per = 0.5 * (tr_rt + tr_tr - 4.0 + maha_r + maha_t)
         else:
             fn = {"kld-printed": dv.kld_printed, "skld-printed": dv.skld_printed,
-                  "kld-exact": dv.kld_exact, "skld-exact": dv.skld_exact}[method]
+                  "kld-exact": dv.kld_exact, "skld-exact": dv.skld_exact}.get(method)
             # (26): elevation and azimuth treated as independent scalar Gaussians
-            per = fn(da, c["ta"], 0.0, ra) + fn(db, c["tb"], 0.0, rb)
+            if fn is not None:
+                per = fn(da, c["ta"], 0.0, ra) + fn(db, c["tb"], 0.0, rb)
+            else:                       # kld-reversed: KL(measurement || pseudo-measurement)
+                per = (dv.kld_exact(0.0, ra, da, c["ta"]) +
+                       dv.kld_exact(0.0, rb, db, c["tb"]))
     return 0.5 * np.where(g.mask, per, 0.0).sum(axis=1)
 
 
@@ -370,10 +384,18 @@ def build_costs(scan: Scan, methods: Sequence[str] = tuple(COSTS), *, localiser:
     for m in methods:
         if m not in COSTS:
             raise InvalidProblemError(f"unknown cost {m!r}; valid: {', '.join(COSTS)}")
-    geom = tuple_geometry(scan, localiser=localiser, covariance=covariance)
-    const = _constants(scan, geom, normalisation)
-    return {m: tuple_costs(scan, geom, m, normalisation=normalisation, const=const)
-            for m in methods}
+    geoms: dict[str, TupleGeometry] = {}
+    out: dict[str, SDCosts] = {}
+    const = None
+    for m in methods:
+        loc = COST_LOCALISER.get(m, localiser)
+        if loc not in geoms:
+            geoms[loc] = tuple_geometry(scan, localiser=loc, covariance=covariance)
+        g = geoms[loc]
+        if const is None:                  # the constants depend on the tuples and R only
+            const = _constants(scan, g, normalisation)
+        out[m] = tuple_costs(scan, g, m, normalisation=normalisation, const=const)
+    return out
 
 
 def build_problem(scan: Scan, method: str = "pattipati", *, costs: SDCosts | None = None,
