@@ -340,8 +340,9 @@ def parameters(options: Mapping[str, Any] | None = None) -> dict[str, Any]:
 
 TABLE_COLUMNS = tuple((s, d) for s in SIGMAS for d in (0.5, 1.0, 1.5))
 #: Pairs of costs whose per-trial outcomes are compared (how often they decide differently).
-DISAGREEMENT_PAIRS = (("kld-printed", "skld-printed"), ("kld-exact", "pattipati"),
-                      ("kld-joint", "pattipati"), ("pattipati-ml", "pattipati"))
+DISAGREEMENT_PAIRS = (("kld-printed", "skld-printed"), ("kld-reversed", "kld-printed"),
+                      ("kld-exact", "pattipati"), ("kld-joint", "pattipati"),
+                      ("skld-exact", "pattipati"), ("pattipati-ml", "pattipati"))
 
 
 def outcome_disagreements(store, exp: Experiment, a: str, b: str) -> dict[str, int]:
