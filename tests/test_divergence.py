@@ -62,13 +62,42 @@ def test_printed_forms_as_printed():
     assert skld_printed(1.0, 2.0, 0.0, 4.0) != pytest.approx(skld_exact(1.0, 2.0, 0.0, 4.0))
 
 
-def test_printed_27_in_the_papers_geometry():
-    """Printed (27) in the paper's geometry: s~ ~ 0.88-1.34 mrad for s = 1.5 mrad gives
-    about -5.5e4 .. -4.2e5 rad^-2."""
+def test_printed_27_over_the_reproductions_region():
+    """(27) at the true association over the region the reproduction draws targets in:
+    s~ recomputed independently (finite-difference Jacobian of the bearings at the LS
+    position, sandwiching the LS covariance), (27) recomputed from its printed formula,
+    and negative exactly where s~ < s and the mean difference is small."""
+    from assocopt.reproduce.lu2013.divergence import printed_kld_over_region
+    from assocopt.tracking.localisation import angles, wrap_angle
+    from assocopt.tracking.scenarios.lu2013 import PAPER_SENSORS_KM
     s = 1.5e-3
-    for st_ in (0.88e-3, 1.34e-3):
-        v = kld_printed(0.0, st_ ** 2, 0.0, s ** 2)
-        assert -4.3e5 < v < -5.4e4
+    r = printed_kld_over_region(1.5, n=30, seed=3)
+    S = np.asarray(PAPER_SENSORS_KM)
+    h = 1e-6
+    for k in range(30):
+        x, P = r["x"][k], r["P"][k]
+        J = np.stack([(angles(x + h * e, S) - angles(x - h * e, S)) / (2 * h)
+                      for e in np.eye(3)], axis=-1)                      # (3, 2, 3)
+        J[:, 1] = wrap_angle(J[:, 1] * 2 * h) / (2 * h)
+        var_t = np.einsum("sai,ij,saj->sa", J, P, J)
+        assert np.sqrt(var_t) / s == pytest.approx(r["ratio"][k], rel=1e-5)
+        diff = angles(x, S) - r["meas"][k]
+        diff[:, 1] = wrap_angle(diff[:, 1])
+        want = ((var_t - s * s) + diff ** 2) / (2 * s * s * var_t)
+        assert want == pytest.approx(r["kld27"][k], rel=1e-5, abs=1e-5 / s ** 2)
+    neg = r["kld27"] < 0
+    assert (r["ratio"][neg] < 1).all()          # (27) < 0 only where s~ < s
+    assert neg.any() and (r["ratio"] < 1).mean() > 0.5
+
+
+def test_committed_lu2013_summary_has_the_printed_27_range_the_code_gives():
+    """The numbers the lu2013 page shows for (27) over the region are this code's."""
+    import json
+    from pathlib import Path
+    from assocopt.reproduce.lu2013.divergence import printed_kld_summary
+    path = Path(__file__).resolve().parents[1] / "docs/papers/lu2013/summary.json"
+    committed = json.loads(path.read_text())["derived"]["printed_kld"]
+    assert printed_kld_summary((1.5, 5.0)) == pytest.approx(committed, rel=1e-12)
 
 
 def test_multivariate_reduces_to_scalar_and_to_sum_for_diagonal():

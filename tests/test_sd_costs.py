@@ -130,7 +130,8 @@ def _reference_cost(scan, t, method):
     for s in real:
         m[0, s] = scan.meas[s][t[s] - 1]
         R[0, s] = scan.R[s][t[s] - 1]
-    loc = localise(m, scan.sensors, R, np.array([[t[s] > 0 for s in range(N)]]))
+    loc = localise(m, scan.sensors, R, np.array([[t[s] > 0 for s in range(N)]]),
+                   method="ils" if method == "pattipati-ml" else "ls")
     pm = pseudo_measurements(loc.x, loc.P, scan.sensors)
     total = 0.0
     for s in range(N):
@@ -143,8 +144,12 @@ def _reference_cost(scan, t, method):
         delta[1] = wrap_angle(delta[1])
         mu_t = m[0, s] + delta
         St = pm.cov[0, s]
-        if method == "pattipati":
+        if method in ("pattipati", "pattipati-ml"):
             total += 0.5 * delta @ np.linalg.solve(Rs, delta)
+        elif method == "kld-reversed":        # KL(measurement || pseudo-measurement)
+            total += 0.5 * sum(
+                0.5 * (Rs[c, c] / St[c, c] - 1 - math.log(Rs[c, c] / St[c, c])
+                       + (mu_t[c] - m[0, s, c]) ** 2 / St[c, c]) for c in (0, 1))
         elif method.endswith("joint"):
             f = kld_gauss if method.startswith("kld") else skld_gauss
             total += 0.5 * float(f(mu_t, St, m[0, s], Rs))
@@ -219,7 +224,10 @@ def test_builder_records_its_options():
     assert c.options == {"normalisation": "gaussian", "localiser": "ls",
                          "covariance": "residual"}
     assert set(COSTS) == {"pattipati", "kld-printed", "skld-printed", "kld-exact",
-                          "skld-exact", "kld-joint", "skld-joint"}
+                          "skld-exact", "kld-joint", "skld-joint", "pattipati-ml",
+                          "kld-reversed"}
+    ml = build_costs(scan, ["pattipati-ml"])["pattipati-ml"]
+    assert ml.options["localiser"] == "ils"          # its own localiser, whatever the run's
 
 
 def test_all_real_tuple_count_for_m20():

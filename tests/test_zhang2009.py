@@ -211,15 +211,18 @@ def test_reproduction_writes_summary_tables_and_resumes(tmp_path):
     s = repro.run(2, 1, 3, tmp_path, echo=printed.append)
     data = json.loads((tmp_path / "summary.json").read_text())
     assert data["paper"] == "zhang2009" and data["runs"] == 2
-    assert data["paper_values"]["table1"]["MD-2DA"][0] == 0.0046
     assert "f_grid" in data["parameters"]["ours"]["ours"]
     rec = data["records"][0]
     assert {"setting", "method", "metric", "value", "runs", "experiment"} <= set(rec)
     exps = {r["experiment"] for r in data["records"]}
-    assert exps == {"main", "weights", "table1", "sensitivity"}
+    assert exps == {"main", "weights", "table1", "table1-enum", "sensitivity"}
     assert all(r["runs"] == 2 for r in data["records"] if r["metric"] == "correct_rate")
     text = printed[0]
-    assert "paper: MD-2DA | 0.0046" in text and "Fig. 3" in text
+    # the paper's Table 1 in the paper's own digits (not rounded to 3 figures)
+    assert "| paper: MD-2DA | 0.0046 | 0.0187 | 0.0635 | 0.2404 | 0.6176 | 0.8699 |" in text
+    assert "| paper: MD-ND | 0.00087 | 0.000978 | 0.0013 | 0.0013 | 0.0017 | 0.0023 |" in text
+    assert "(derived)" in text and "Fig. 3" in text
+    assert text == repro.render_tables(data)          # tables.md is a function of summary.json
     for f in s["figures"]:
         assert (tmp_path / f).stat().st_size > 0
     again = repro.run(2, 1, 3, tmp_path, echo=lambda t: None)
@@ -242,3 +245,83 @@ def test_reproduction_rejects_unknown_options():
     from assocopt.reproduce import zhang2009 as repro
     with pytest.raises(ValueError, match="unknown zhang2009 option"):
         repro.experiments(2, 0, {"bogus": 1})
+
+
+# ------------------------------------------------------- pinned reproduced numbers
+def test_pinned_trials_at_a_small_seeded_run():
+    """Eight seeded runs of the f sweep at f = 0.3: P_c of every method of the main
+    experiment, pinned when the reproduction was run, and one enumerated MD-2DA."""
+    from assocopt.experiments import trial_seed
+    from assocopt.reproduce import zhang2009 as repro
+    exps = {e.name: e for e in repro.experiments(1, 0)}
+    st = [s for s in exps["zhang2009-main"].settings if s["sweep"] == "f" and s["f"] == 0.3][0]
+    got = {m: [] for m in repro.MAIN_METHODS}
+    for t in range(8):
+        r = repro.trial(st, list(got), trial_seed(0, st, t))
+        for m in got:
+            got[m].append(r[m]["correct_rate"])
+    assert got == pytest.approx({
+        "tbm+nd": [1.0, 6 / 7, 8 / 9, 1.0, 5 / 9, 1.0, 8 / 9, 6 / 7],
+        "ncr+nd": [1.0, 1.0, 1.0, 1.0, 5 / 9, 1.0, 8 / 9, 6 / 7],
+        "ncr+2da": [1.0, 1.0, 1.0, 1.0, 7 / 9, 1.0, 1.0, 1.0],
+        "ncr+2da-rect": [5 / 7, 5 / 7, 7 / 9, 1.0, 2 / 3, 1.0, 5 / 9, 5 / 7]}, rel=1e-12)
+    st2 = exps["zhang2009-table1-enum"].settings[0]
+    r = repro.trial(st2, ["ncr+2da-enum"], trial_seed(0, st2, 0))["ncr+2da-enum"]
+    assert (r["stopped"], r["n_feasible"], r["correct_rate"]) == (0.0, 229.0, 1.0)
+
+
+def test_enumeration_reports_a_stopped_run():
+    from assocopt.experiments import trial_seed
+    from assocopt.reproduce import zhang2009 as repro
+    st = dict(repro.experiments(1, 0, {"enum_max_nodes": 50})[-2].settings[-1])
+    assert st["p_d"] == 1.0 and st["enum_max_nodes"] == 50
+    r = repro.trial(st, ["ncr+2da-enum"], trial_seed(0, st, 0))["ncr+2da-enum"]
+    assert r["stopped"] == 1.0 and r["correct_rate"] is None and r["t_decide_finished"] is None
+
+
+def test_expected_matchings_against_enumeration():
+    """The derived Table 1 rows: closed form against brute-force counting."""
+    import itertools
+    import math
+    from assocopt.reproduce.zhang2009.report import expected_matchings
+
+    def count(a, b):
+        n = 0
+        for k in range(min(a, b) + 1):
+            n += sum(1 for _ in itertools.combinations(range(a), k)) * math.perm(b, k)
+        return n
+    n, p = 4, 0.6
+    pmf = [math.comb(n, k) * p ** k * (1 - p) ** (n - k) for k in range(n + 1)]
+    feas = sum(pmf[a] * pmf[b] * count(a, b) for a in range(n + 1) for b in range(n + 1))
+    comp = sum(pmf[a] * pmf[b] * len(list(itertools.permutations(range(max(a, b)), min(a, b))))
+               for a in range(n + 1) for b in range(n + 1))
+    assert expected_matchings(p, n) == pytest.approx((feas, comp), rel=1e-12)
+
+
+def test_covariance_scale_is_a_real_parameter():
+    from assocopt.scenarios.zhang2009 import Zhang2009
+    a = Zhang2009(f=0.3, p_d=1.0).simulate(np.random.default_rng(4))
+    b = Zhang2009(f=0.3, p_d=1.0, covariance_scale=4.0).simulate(np.random.default_rng(4))
+    assert np.allclose(a.observations.positions, b.observations.positions)
+    assert np.allclose(4 * a.observations.covariances, b.observations.covariances)
+    with pytest.raises(ValueError, match="covariance_scale"):
+        Zhang2009(covariance_scale=0.0)
+
+
+def test_committed_summary_regenerates_from_the_code(tmp_path):
+    """Recompute one point of the committed run from scratch (Exp. 1b, k = 1, its full
+    run count) and compare with docs/papers/zhang2009/summary.json exactly."""
+    import json
+    from pathlib import Path
+    from assocopt.experiments import Experiment, run_experiment, summarise
+    from assocopt.reproduce import zhang2009 as repro
+    js = json.loads((Path(__file__).resolve().parents[1] / "docs/papers/zhang2009/summary.json")
+                    .read_text())
+    exp = repro.experiments(js["runs"], js["seed"], parts=("weights",))[0]
+    one = Experiment(exp.name, [s for s in exp.settings if s["k"] == 1], exp.methods,
+                     exp.trial, exp.runs, exp.seed, exp.params, exp.volatile)
+    run_experiment(one, tmp_path / "w.sqlite")
+    mine = {(r["method"], r["metric"]): r["value"] for r in summarise(tmp_path / "w.sqlite", one)}
+    committed = {(r["method"], r["metric"]): r["value"] for r in js["records"]
+                 if r["experiment"] == "weights" and r["setting"]["k"] == 1 and not r["volatile"]}
+    assert committed and {k: mine[k] for k in committed} == pytest.approx(committed, rel=1e-12)

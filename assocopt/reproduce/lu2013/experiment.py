@@ -2,6 +2,7 @@
 the experiment definitions (see :mod:`assocopt.reproduce.lu2013`).
 """
 
+
 from __future__ import annotations
 
 import math
@@ -14,14 +15,15 @@ import numpy as np
 from ...api import solve
 from ...tracking.costs.sd_builder import COSTS, build_costs, build_problem
 from ...experiments import Experiment, association_metrics
-from ...tracking.scenarios.lu2013 import PAPER, Lu2013
+from ...tracking.scenarios.lu2013 import PAPER, REPRODUCTION_REGION_KM, Lu2013
 from ...problem import AssignmentProblem
 from ...solution import Status
 from ...solvers.bruteforce import enumerate_solutions
 from ... import lp_fixing
 
 __all__ = ["METHODS", "PAPER_TABLES", "PAPER_FIG2_GAIN", "DEFAULTS", "experiments",
-           "fig_trial", "table_trial", "parameters", "D_GRID", "TABLE_GRID", "TABLE_COLUMNS"]
+           "fig_trial", "table_trial", "parameters", "D_GRID", "TABLE_GRID", "TABLE_COLUMNS",
+           "table_experiment_name", "outcome_disagreements", "DISAGREEMENT_PAIRS"]
 
 #: Methods run by the reproduction: the paper's three as printed, then ours.
 METHODS = tuple(COSTS)
@@ -53,13 +55,21 @@ PAPER_TABLES: dict[int, dict[str, tuple[float, ...]]] = {
 PAPER_FIG2_GAIN = {"KLD": {1.5: 0.23, 5.0: 0.2}, "SKLD": {1.5: 0.78, 5.0: 1.4}}
 
 #: Defaults of the parameters the paper does not give (ours), and run options:
-#: ``region_km`` / ``line_direction`` (scenario, ours); ``solver`` (exact back end for
-#: the ILP, any exact name of :func:`assocopt.solvers.available`); ``ilp_strategy``
+#: ``region_km`` (scenario, ours); ``line_directions`` (the line geometries of
+#: Tables 1-4, each run as its own experiment; the pair of Figs. 1-2 always lies along
+#: +x, as §4.1 prints it); ``elevation_sigma_ratio`` (elevation sigma / azimuth
+#: sigma, 1 = the same sigma for both angles); ``solver`` (exact back end for the ILP,
+#: any exact name of :func:`assocopt.solvers.available`); ``ilp_strategy``
 #: ("lp-fixing" or "full"); ``localiser`` ("ls", "ils", "tls"); ``covariance``
-#: ("residual", "printed"); ``normalisation`` ("printed", "gaussian", "none").
+#: ("residual", "printed"); ``normalisation`` ("printed", "gaussian", "none");
+#: ``other_geometry_runs`` (runs per point for every geometry after the first; None =
+#: ``runs``); ``region_scan_L`` (side lengths L of the regions [0, L]^2 x [1, 10] km
+#: of the region scan, run with ref. [2] at M = 5, sigma = 1.5, d = 0.5 and
+#: ``max(2, runs // 5)`` runs; () skips it).
 DEFAULTS: dict[str, Any] = {
-    "region_km": ((0.0, 50.0), (0.0, 50.0), (1.0, 10.0)),
-    "line_direction": "x",
+    "region_km": REPRODUCTION_REGION_KM,
+    "line_directions": ("x", "horizontal"),
+    "elevation_sigma_ratio": 1.0,
     # "highs", not "auto": when this was written "auto" resolved to "lagrangian-exact"
     # for S-D, which raised TypeError (lagrangian _close_gap, incumbent None) or
     # searched for minutes on some of the small restricted ILPs left by the fixing step.
@@ -68,16 +78,27 @@ DEFAULTS: dict[str, Any] = {
     "localiser": "ls",
     "covariance": "residual",
     "normalisation": "printed",
+    "other_geometry_runs": None,
+    "region_scan_L": (20.0, 30.0, 40.0, 50.0),
 }
-#: Which of DEFAULTS are modelling choices of ours (vs. run options).
-OURS_PARAMS = ("region_km", "line_direction", "d_unit", "sigma_same_for_both_angles",
+#: Which parameters are modelling choices of ours (vs. run options).
+OURS_PARAMS = ("region_km", "line_directions", "d_unit", "sigma_same_for_both_angles",
                "localiser", "covariance", "normalisation", "r_convention",
                "correct_rate_definitions")
+#: Keys of an option set that enter every setting (they change the simulated data or
+#: the costs); the rest are run options.
+_SCENARIO_OPTS = ("region_km", "localiser", "covariance", "normalisation",
+                  "elevation_sigma_ratio")
+_SOLVER_OPTS = ("solver", "ilp_strategy")
+#: The region scan's cell (the one cell of Table 1 the region was chosen on).
+REGION_SCAN_CELL = {"M": 5, "sigma_mrad": 1.5, "d": 0.5}
 
 
 def _scenario(setting: Mapping[str, Any], n_targets: int) -> Lu2013:
-    return Lu2013(n_targets=n_targets, d=float(setting["d"]),
-                  sigma_mrad=float(setting["sigma_mrad"]),
+    sigma = float(setting["sigma_mrad"])
+    ratio = float(setting.get("elevation_sigma_ratio", 1.0))
+    return Lu2013(n_targets=n_targets, d=float(setting["d"]), sigma_mrad=sigma,
+                  sigma_elevation_mrad=None if ratio == 1.0 else ratio * sigma,
                   region_km=tuple(tuple(r) for r in setting["region_km"]),
                   line_direction=setting["line_direction"])
 
@@ -215,61 +236,125 @@ def _solve_metrics(prob, setting: Mapping[str, Any], lp: "lp_fixing.LPResult | N
             "t_lp": t_lp, "t_ilp": t_ilp, "_tuples": sol_tuples}
 
 
-def experiments(runs: int, seed: int, options: Mapping[str, Any] | None = None,
-                parts: Sequence[str] = ("fig", "tables")) -> list[Experiment]:
-    """The Experiments of the reproduction (``options`` override :data:`DEFAULTS`)."""
+def _options(options: Mapping[str, Any] | None) -> dict[str, Any]:
     opts = {**DEFAULTS, **(options or {})}
     unknown = set(opts) - set(DEFAULTS)
     if unknown:
         raise ValueError(f"unknown lu2013 option(s) {sorted(unknown)}; valid: {sorted(DEFAULTS)}")
-    Lu2013(region_km=opts["region_km"], line_direction=opts["line_direction"])   # validate
+    dirs = tuple(opts["line_directions"])
+    if not dirs or len(set(dirs)) != len(dirs):
+        raise ValueError(f"line_directions must be distinct names, got {dirs!r}")
+    for ld in dirs:                                                   # validate
+        Lu2013(region_km=opts["region_km"], line_direction=ld)
+    if not float(opts["elevation_sigma_ratio"]) > 0:
+        raise ValueError(f"elevation_sigma_ratio must be > 0, got {opts['elevation_sigma_ratio']!r}")
     if opts["ilp_strategy"] not in ("lp-fixing", "full"):
         raise ValueError(f"ilp_strategy must be 'lp-fixing' or 'full', got {opts['ilp_strategy']!r}")
-    common = {k: (list(map(list, v)) if k == "region_km" else v) for k, v in opts.items()}
+    og = opts["other_geometry_runs"]
+    if og is not None and (not isinstance(og, int) or isinstance(og, bool) or og < 1):
+        raise ValueError(f"other_geometry_runs must be a positive integer or None, got {og!r}")
+    return opts
+
+
+def table_experiment_name(line_direction: str, first: bool) -> str:
+    """Store name of the Tables 1-4 experiment of one line geometry."""
+    return "lu2013-tables" if first else f"lu2013-tables-{line_direction}"
+
+
+def experiments(runs: int, seed: int, options: Mapping[str, Any] | None = None,
+                parts: Sequence[str] = ("fig", "tables", "region")) -> list[Experiment]:
+    """The Experiments of the reproduction (``options`` override :data:`DEFAULTS`).
+
+    ``tables`` gives one experiment per line geometry (``line_directions``); the
+    first keeps the store name ``lu2013-tables``.
+    """
+    opts = _options(options)
+    common = {k: (list(map(list, opts[k])) if k == "region_km" else opts[k])
+              for k in _SCENARIO_OPTS}
+    common["elevation_sigma_ratio"] = float(common["elevation_sigma_ratio"])
+    solver = {k: opts[k] for k in _SOLVER_OPTS}
     out = []
     if "fig" in parts:
-        fig_common = {k: v for k, v in common.items() if k not in ("solver", "ilp_strategy")}
-        settings = [{"part": "fig", "sigma_mrad": s, "d": d, **fig_common}
+        settings = [{"part": "fig", "sigma_mrad": s, "d": d, "line_direction": "x", **common}
                     for s in SIGMAS for d in D_GRID]
         out.append(Experiment("lu2013-fig", settings, METHODS, fig_trial, runs, seed,
                               params={"experiment": "fig"},
                               volatile=("t_cost",)))
     if "tables" in parts:
-        settings = [{"part": "tables", "M": M, "sigma_mrad": s, "d": d, **common}
-                    for M, s, d in TABLE_GRID]
-        out.append(Experiment("lu2013-tables", settings, METHODS, table_trial, runs, seed,
-                              params={"experiment": "tables"},
+        for i, ld in enumerate(opts["line_directions"]):
+            settings = [{"part": "tables", "M": M, "sigma_mrad": s, "d": d,
+                         "line_direction": ld, **common, **solver}
+                        for M, s, d in TABLE_GRID]
+            n = runs if i == 0 or opts["other_geometry_runs"] is None else \
+                min(runs, opts["other_geometry_runs"])
+            out.append(Experiment(table_experiment_name(ld, i == 0), settings, METHODS,
+                                  table_trial, n, seed, params={"experiment": "tables"},
+                                  volatile=("t_cost", "t_lp", "t_ilp")))
+    if "region" in parts and opts["region_scan_L"]:
+        settings = [{"part": "region", "L": float(L), **REGION_SCAN_CELL, "line_direction": "x",
+                     **{**common, "region_km": [[0.0, float(L)], [0.0, float(L)], [1.0, 10.0]]},
+                     **solver} for L in opts["region_scan_L"]]
+        out.append(Experiment("lu2013-region", settings, ("pattipati",), table_trial,
+                              max(2, runs // 5), seed, params={"experiment": "region"},
                               volatile=("t_cost", "t_lp", "t_ilp")))
     return out
 
 
 def parameters(options: Mapping[str, Any] | None = None) -> dict[str, Any]:
     """The parameters of a run: the paper's, ours (marked), and run options."""
-    opts = {**DEFAULTS, **(options or {})}
-    sc = Lu2013(region_km=opts["region_km"], line_direction=opts["line_direction"])
+    opts = _options(options)
+    sc = Lu2013(region_km=opts["region_km"])
     return {
         "paper": {**PAPER, "sensors_km": [list(s) for s in PAPER["sensors_km"]],
                   "solver": "lp_solve (LP relaxation)"},
         "ours": {
             "region_km": [list(r) for r in sc.region_km],
-            "line_direction": sc.line_direction,
+            "line_directions": list(opts["line_directions"]),
             "line_layout": "first target uniform in region_km, others at +k*d along the "
-                           "line (as the pair of §4.1)",
+                           "line: 'x' = along +x (as the pair of §4.1), 'horizontal' = in a "
+                           "uniformly random horizontal direction per run",
+            "fig_pair": "(x, y, z) and (x + d, y, z), as §4.1 prints it",
             "d_unit": "km",
-            "sigma_same_for_both_angles": True,
+            "sigma_same_for_both_angles": float(opts["elevation_sigma_ratio"]) == 1.0,
+            "elevation_sigma_ratio": float(opts["elevation_sigma_ratio"]),
             "localiser": opts["localiser"],
-            "covariance": opts["covariance"] + " (the residual Jacobian corrects (16))",
-            "normalisation": opts["normalisation"] + " (the constant of (7))",
+            "covariance": opts["covariance"] + (
+                " (LS covariance with the residual Jacobian; the printed dY/dm form is too "
+                "small)" if opts["covariance"] == "residual" else ""),
+            "normalisation": opts["normalisation"] + (
+                " (constants ln(sqrt(2 pi det R)/P_D) as printed)"
+                if opts["normalisation"] == "printed" else ""),
             "r_convention": "r_data: C_best/C_ave on the costs without the constant terms "
-                            "(r depends on them); r_full: on the costs as printed (radians)",
+                            "; r_full: on the costs as printed (radians)",
             "correct_rate_definitions": "partition_correct: whole partition right; "
                                         "tuple_rate: fraction of true target tuples found",
             "measurement_order": "shuffled per sensor",
             "ours": list(OURS_PARAMS),
         },
         "run": {"solver": opts["solver"], "ilp_strategy": opts["ilp_strategy"],
-                "lp_solver": "highs (presolve off)"},
+                "lp_solver": "highs (presolve off)",
+                "other_geometry_runs": opts["other_geometry_runs"],
+                "region_scan_L": list(opts["region_scan_L"])},
     }
 
 
 TABLE_COLUMNS = tuple((s, d) for s in SIGMAS for d in (0.5, 1.0, 1.5))
+#: Pairs of costs whose per-trial outcomes are compared (how often they decide differently).
+DISAGREEMENT_PAIRS = (("kld-printed", "skld-printed"), ("kld-reversed", "kld-printed"),
+                      ("kld-exact", "pattipati"), ("kld-joint", "pattipati"),
+                      ("skld-exact", "pattipati"), ("pattipati-ml", "pattipati"))
+
+
+def outcome_disagreements(store, exp: Experiment, a: str, b: str) -> dict[str, int]:
+    """In how many trials methods ``a`` and ``b`` differ in tuple rate or partition
+    correctness (trials 0 .. runs-1 where both are stored)."""
+    from ...experiments import ResultStore, setting_key
+    keys = {setting_key(s) for s in exp.settings}
+    got: dict[tuple[str, int], dict[str, tuple]] = {}
+    with ResultStore(store) as st:
+        for s, m, t, metrics in st.rows():
+            if s in keys and t < exp.runs and m in (a, b):
+                got.setdefault((s, t), {})[m] = (metrics.get("tuple_rate"),
+                                                 metrics.get("partition_correct"))
+    both = [v for v in got.values() if a in v and b in v]
+    return {"differ": sum(v[a] != v[b] for v in both), "trials": len(both)}

@@ -17,8 +17,7 @@ Four experiments, each with its own results store ``OUT/zhang2009-*.sqlite``:
                  pi = 0) at three noise levels.
 
 Every method of a trial decides on the same simulated run (paired comparison).
-The metric is :func:`~assocopt.tracking.group_matching.correct_match_rate` (P_c, defined in
-docs/papers/zhang2009.md)
+The metric is :func:`~assocopt.group_matching.correct_match_rate` (P_c: correct relations / true relations per run, averaged)
 and ``all_correct`` (the run's relations entirely right); timings are volatile
 metrics (seconds per decision, the matching measures excluded).
 """
@@ -29,11 +28,14 @@ from pathlib import Path
 from typing import Any, Mapping, Sequence
 
 from ...experiments import report_records, run_all, summarise
+from ...io.writers import jsonable
 from .._report import write_report
-from .experiment import (DEFAULTS, LABELS, MAIN_METHODS, METHODS, PAPER_CLAIMS,  # noqa: F401
-                         PAPER_METHODS, PAPER_TABLE1, TABLE1_METHODS, TABLE1_PD, VOLATILE, R, W,
-                         _measure_params, _options, experiments, parameters, trial)
-from .report import PAIRS, make_figures, paired_differences, render_tables  # noqa: F401
+from ..runlog import timing_history, trial_seconds
+from .experiment import (DEFAULTS, LABELS, MAIN_METHODS, METHODS, PAIRS,  # noqa: F401
+                         PAPER_CLAIMS, PAPER_METHODS, PAPER_TABLE1, R, TABLE1_METHODS,
+                         TABLE1_PD, VOLATILE, W, _measure_params, _options, experiments,
+                         paired_differences, parameters, trial)
+from .report import make_figures, render_tables  # noqa: F401
 
 __all__ = ["W", "R", "PAPER_TABLE1", "PAPER_CLAIMS", "DEFAULTS", "METHODS", "experiments",
            "trial", "parameters", "run", "render_tables", "make_figures"]
@@ -47,11 +49,14 @@ def run(runs: int, workers: int, seed: int, out, *, progress: bool = False,
 
     Writes ``out/summary.json``, ``out/tables.md``, PNG figures (when matplotlib is
     installed) and the stores ``out/zhang2009-*.sqlite``; prints the tables with
-    ``echo``.  Returns the summary dict.
+    ``echo``.  ``summary.json`` keeps, under ``timing_history``, the wall time of every
+    invocation into ``out`` that computed trials.  Returns the summary dict.
     """
     out = Path(out)
     exps = experiments(runs, seed, options, parts)
     timing = run_all(exps, out, workers=workers, executor=executor, progress=progress)
+    history = timing_history(out / "summary.json", timing, runs=runs, workers=workers,
+                             seed=seed, options=options)
     records: list[dict[str, Any]] = []
     for exp in exps:
         rows = summarise(out / f"{exp.name}.sqlite", exp, include_volatile=True)
@@ -64,7 +69,7 @@ def run(runs: int, workers: int, seed: int, out, *, progress: bool = False,
     summary = {
         "paper": "zhang2009",
         "title": "Group member matching with position + attribute belief functions "
-                 "(Zhang et al. 2009, paper 000)",
+                 "(Zhang et al. 2009)",
         "runs": runs, "seed": seed, "workers": workers,
         "methods": {m: {"measure": METHODS[m][0], "decision": METHODS[m][1],
                         "options": METHODS[m][2], "label": LABELS.get(m, m)}
@@ -75,5 +80,8 @@ def run(runs: int, workers: int, seed: int, out, *, progress: bool = False,
         "records": records,
         "paired": paired,
         "timing": timing,
+        "timing_history": history,
+        "trial_seconds": trial_seconds(out, [e.name for e in exps]),
     }
+    summary = jsonable(summary, nonfinite="null")        # as summary.json stores it
     return write_report(out, summary, render_tables, make_figures, echo)

@@ -1,26 +1,29 @@
-"""Paper 000's experiments: the methods, the printed values, the trial function and
-the experiment definitions (see :mod:`assocopt.reproduce.zhang2009`).
+"""Paper 000's experiments: methods, grids, printed values, the trial function, the
+experiment definitions and the paired comparisons (see :mod:`assocopt.reproduce.zhang2009`).
 """
+
 
 from __future__ import annotations
 
 import math
 import time
+from pathlib import Path
 from typing import Any, Mapping, Sequence
 
 import numpy as np
 
-from ...api import choose_solver
-from ...tracking.decide.md2da import gate_threshold, md_2da
-from ...tracking.decide.truncation import TruncationOptions, md_nd
+from ...api import choose_solver, solve
 from ...experiments import Experiment
-from ...tracking.group_matching import (MeasureParams, correct_match_rate, matching_matrix,
-                                        pair_components)
 from ...problem import AssignmentProblem
+from ...solution import Status
+from ...tracking.decide.md2da import gate_threshold, md_2da, md_2da_problem
+from ...tracking.decide.truncation import TruncationOptions, md_nd
+from ...tracking.group_matching import (MeasureParams, Relations, correct_match_rate,
+                                        matching_matrix, pair_components)
 from ...tracking.scenarios.zhang2009 import OURS, PAPER, Zhang2009
 
 __all__ = ["W", "R", "PAPER_TABLE1", "PAPER_CLAIMS", "DEFAULTS", "METHODS", "experiments",
-           "trial", "parameters"]
+           "trial", "parameters", "run", "render_tables", "make_figures"]
 
 #: Experiment 1b (§5.1): MM-WA weights w(1,k), w(2,k) and MM-NCR reliabilities r(1,k), r(2,k).
 W = ((0.1, 0.2, 0.3, 0.4, 0.5, 0.6, 0.7, 0.8, 0.9, 1.0),
@@ -63,9 +66,12 @@ DEFAULTS: dict[str, Any] = {
     "ordering": "prim",
     "sensitivity_f": (0.1, 0.3, 0.6),
     "sensitivity_alpha": (0.001, 0.01, 0.05, 0.2),
+    "covariance_scale": 1.0,   # covariance in d^2 = scale x the true noise covariance
+    "enum_runs": 20,           # runs per P_d of the enumerating MD-2DA (Table 1)
+    "enum_max_nodes": 2_000_000,   # its search-node limit (then: stopped, reported)
 }
 _SCENARIO_KEYS = ("region", "type_assignment", "confusion_size", "confusion_includes_true",
-                  "noise_reference")
+                  "noise_reference", "covariance_scale")
 
 #: Method name -> (measure, decision, options).  decision "nd" (truncation) or "2da".
 METHODS: dict[str, tuple[str, str, dict[str, Any]]] = {
@@ -75,6 +81,7 @@ METHODS: dict[str, tuple[str, str, dict[str, Any]]] = {
     "ncr+2da": ("ncr", "2da", {}),
     "ncr+2da-rect": ("ncr", "2da", {"tau": 0.0}),
     "ncr+2da-highs": ("ncr", "2da", {"solver": "highs"}),
+    "ncr+2da-enum": ("ncr", "2da", {"solver": "bruteforce"}),
     "ncr+nd-dendrogram": ("ncr", "nd", {"ordering": "dendrogram"}),
     "ncr+nd-samezero": ("ncr", "nd", {"same_sensor": "zero"}),
 }
@@ -84,16 +91,17 @@ for _a in DEFAULTS["sensitivity_alpha"]:
 LABELS = {"tbm+nd": "MM-TBM (truncation)", "ncr+nd": "MM-NCR / MD-ND",
           "wa+nd": "MM-WA (truncation)", "ncr+2da": "MD-2DA (gated, ours)",
           "ncr+2da-rect": "MD-2DA (tau = 0, rectangular)",
-          "ncr+2da-highs": "MD-2DA via HiGHS", "ncr+nd-dendrogram": "MD-ND, dendrogram order",
+          "ncr+2da-highs": "MD-2DA via HiGHS",
+          "ncr+2da-enum": "MD-2DA by enumeration (brute force)",
+          "ncr+nd-dendrogram": "MD-ND, dendrogram order",
           "ncr+nd-samezero": "MD-ND, same-sensor pi = 0"}
 LABELS.update({f"ncr+2da-a{a:g}": f"MD-2DA, alpha = {a:g}" for a in DEFAULTS["sensitivity_alpha"]})
 
-#: Methods as the paper defines them (MD-2DA's cost and threshold are ours: the paper
-#: gives neither).
+#: Methods as the paper defines them (MD-2DA's cost and threshold are ours).
 PAPER_METHODS = ("tbm+nd", "ncr+nd", "wa+nd")
 MAIN_METHODS = ("tbm+nd", "ncr+nd", "ncr+2da", "ncr+2da-rect")
 TABLE1_METHODS = ("ncr+nd", "ncr+2da", "ncr+2da-highs")
-VOLATILE = ("t_decide", "t_backend")
+VOLATILE = ("t_decide", "t_backend", "t_decide_finished")
 
 
 # ------------------------------------------------------------------- trial
@@ -119,6 +127,12 @@ def trial(setting: Mapping[str, Any], methods: Sequence[str],
         if decision == "nd":
             rel = md_nd(pi, obs.sensor, TruncationOptions(ordering=o["ordering"]))
             res["t_decide"] = time.perf_counter() - t0
+        elif o["solver"] == "bruteforce":
+            res.update(_enumerate(pi, obs.sensor, params, o, int(setting["enum_max_nodes"]),
+                                  draw.truth))
+            res["n_obs"] = float(obs.n)
+            out[name] = res
+            continue
         else:
             tau = o["tau"] if "tau" in o else gate_threshold(params, o["alpha"])
             r = md_2da(pi, obs.sensor, tau=tau, cost=o["cost"], solver=o["solver"])
@@ -132,6 +146,32 @@ def trial(setting: Mapping[str, Any], methods: Sequence[str],
         res["n_pairs_decided"] = float(len(rel.pairs))
         out[name] = res
     return out
+
+
+def _enumerate(pi, sensor, params: MeasureParams, o: Mapping[str, Any], max_nodes: int,
+               truth) -> dict[str, float | None]:
+    """MD-2DA by exhaustive enumeration of every feasible matching (the brute-force
+    back end), stopped after ``max_nodes`` search nodes.  A stopped run reports
+    ``stopped = 1``, its time up to the stop and no P_c (its answer is not proven)."""
+    tau = o["tau"] if "tau" in o else gate_threshold(params, o["alpha"])
+    problem, rows, cols = md_2da_problem(pi, sensor, tau, o["cost"])
+    t0 = time.perf_counter()
+    sol = solve(problem, "bruteforce", max_nodes=max_nodes)
+    dt = time.perf_counter() - t0
+    stopped = sol.status is not Status.OPTIMAL
+    res: dict[str, float | None] = {"t_decide": dt, "stopped": float(stopped),
+                                    "t_decide_finished": None if stopped else dt,
+                                    "correct_rate": None, "all_correct": None}
+    if not stopped:
+        r, c = sol.assignment()
+        matched = set(rows[r].tolist()) | set(cols[c].tolist())
+        clusters = [(int(rows[i]), int(cols[j])) for i, j in zip(r, c)]
+        clusters += [(i,) for i in range(len(sensor)) if i not in matched]
+        rel = Relations.from_clusters(clusters, np.asarray(sensor))
+        res["correct_rate"] = correct_match_rate(rel, truth)
+        res["all_correct"] = float(rel == truth)
+        res["n_feasible"] = float(sol.info.get("solutions", math.nan))
+    return res
 
 
 def _measure_params(setting: Mapping[str, Any], measure: str, same_sensor: str) -> MeasureParams:
@@ -154,6 +194,9 @@ def _options(options: Mapping[str, Any] | None) -> dict[str, Any]:
               **{k: opts[k] for k in _SCENARIO_KEYS})                     # validate
     MeasureParams("ncr", r_p=opts["r_p"], r_a=opts["r_a"], same_sensor=opts["same_sensor"])
     TruncationOptions(ordering=opts["ordering"])
+    for k in ("enum_runs", "enum_max_nodes"):
+        if not isinstance(opts[k], int) or isinstance(opts[k], bool) or opts[k] < 1:
+            raise ValueError(f"{k} must be a positive integer, got {opts[k]!r}")
     return opts
 
 
@@ -183,6 +226,11 @@ def experiments(runs: int, seed: int, options: Mapping[str, Any] | None = None,
                     for p in TABLE1_PD]
         out.append(Experiment("zhang2009-table1", settings, TABLE1_METHODS, trial, runs, seed,
                               params={"experiment": "table1"}, volatile=VOLATILE))
+        settings = [{"sweep": "table1", "f": o["f_fixed"], "p_d": p,
+                     "enum_max_nodes": int(o["enum_max_nodes"]), **common} for p in TABLE1_PD]
+        out.append(Experiment("zhang2009-table1-enum", settings, ("ncr+2da-enum",), trial,
+                              min(runs, int(o["enum_runs"])), seed,
+                              params={"experiment": "table1-enum"}, volatile=VOLATILE))
     if "sensitivity" in parts:
         settings = [{"sweep": "sensitivity", "f": f, "p_d": o["p_d_fixed"], **common}
                     for f in o["sensitivity_f"]]
@@ -218,10 +266,15 @@ def parameters(options: Mapping[str, Any] | None = None) -> dict[str, Any]:
                               f"types k+1..k+{o['confusion_size']} (mod 6)",
             "confusion_size": o["confusion_size"],
             "confusion_includes_true": o["confusion_includes_true"],
-            "noise_reference": o["noise_reference"] + " (the paper's reference is ambiguous)",
-            "covariance_in_d2": "Sigma_1i + Sigma_2j, the true noise covariances (not given)",
-            "same_sensor_pi": o["same_sensor"] + " (not defined by the paper)",
-            "ordering": o["ordering"] + " (not given; start = first sensor-1 observation, "
+            "noise_reference": o["noise_reference"] + (
+                " (sigma = f times the mean nearest-neighbour distance of the run's targets)"
+                if o["noise_reference"] == "per_run" else ""),
+            "covariance_in_d2": f"Sigma_1i + Sigma_2j with Sigma = {o['covariance_scale']:g} x "
+                                "the true noise covariance sigma^2 I",
+            "covariance_scale": o["covariance_scale"],
+            "same_sensor_pi": o["same_sensor"] + " (pi of two observations of one sensor; "
+                                                 "the paper does not define it)",
+            "ordering": o["ordering"] + " (single-linkage order; start = first sensor-1 observation, "
                                         "ties lowest index)",
             "truncation_readings": TruncationOptions(ordering=o["ordering"]).as_dict(),
             "md2da_cost": o["cost"] + ": cost -pi per pair, -tau/2 per unpaired observation",
@@ -229,16 +282,54 @@ def parameters(options: Mapping[str, Any] | None = None) -> dict[str, Any]:
                                f"the chi2(2) gate of level alpha with K = 0 "
                                f"(= {gate_threshold(ncr, o['alpha']):.6g} for MM-NCR, "
                                f"r_p={o['r_p']}, r_a={o['r_a']})",
-            "mm_wa_attribute_conflict": "new conflict (4), as eq. (5) defines m^a "
-                                        "(formula not printed)",
+            "mm_wa_attribute_conflict": "new conflict (4), as eq. (5) defines m^a",
             "metric": "correct_rate: correct relations / true relations per run, averaged; "
-                      "all_correct: fraction of runs entirely right (ours)",
+                      "all_correct: fraction of runs entirely right",
             "observation_order": "shuffled per sensor",
-            "ours": list(OURS) + ["f_grid", "p_d_grid", "f_fixed", "p_d_fixed", "r_p_r_a_exp2",
+            "ours": list(OURS) + ["covariance_in_d2", "f_grid", "p_d_grid", "f_fixed", "p_d_fixed", "r_p_r_a_exp2",
                                   "md2da_cost", "md2da_threshold", "metric", "ordering",
                                   "same_sensor_pi", "mm_wa_attribute_conflict"],
         },
-        "run": {"md2da_solver": solver, "table1_solvers": [solver, "highs"],
+        "run": {"md2da_solver": solver, "table1_solvers": [solver, "highs", "bruteforce"],
+                "enum_runs": o["enum_runs"], "enum_max_nodes": o["enum_max_nodes"],
                 "timing": "time.perf_counter around the decision only (pi excluded); "
                           "t_backend = the back end's own solve time"},
     }
+
+
+#: Paired comparisons (same simulated runs): (experiment, method A, method B).
+PAIRS = (("main", "ncr+nd", "tbm+nd"), ("weights", "ncr+nd", "wa+nd"),
+         ("main", "ncr+2da", "ncr+nd"), ("main", "ncr+2da-rect", "ncr+nd"))
+
+
+def paired_differences(store: Path, exp: Experiment,
+                       metric: str = "correct_rate") -> list[dict[str, Any]]:
+    """Mean and standard error of the per-run difference A - B of ``metric``.
+
+    Both methods decide on the same simulated runs, so the paired standard error is
+    much smaller than the two curves' own.
+    """
+    from ...experiments import ResultStore, setting_key
+    part = exp.params["experiment"]
+    wanted = [(a, b) for e, a, b in PAIRS if e == part and {a, b} <= set(exp.methods)]
+    if not wanted:
+        return []
+    keys = {setting_key(s): s for s in exp.settings}
+    vals: dict[tuple[str, str], dict[int, float]] = {}
+    with ResultStore(store) as st:
+        for s, m, t, metrics in st.rows():
+            if s in keys and t < exp.runs and metrics.get(metric) is not None:
+                vals.setdefault((s, m), {})[t] = metrics[metric]
+    out = []
+    for k, setting in keys.items():
+        for a, b in wanted:
+            va, vb = vals.get((k, a), {}), vals.get((k, b), {})
+            common = sorted(set(va) & set(vb))
+            if len(common) < 2:
+                continue
+            d = np.array([va[t] - vb[t] for t in common])
+            out.append({"experiment": part, "setting": {x: setting[x] for x in
+                                                       ("sweep", "f", "p_d", "k") if x in setting},
+                        "method": f"{a} - {b}", "metric": metric, "value": float(d.mean()),
+                        "stderr": float(d.std(ddof=1) / math.sqrt(len(d))), "runs": len(d)})
+    return out

@@ -28,9 +28,9 @@ import numpy as np
 from numpy.typing import ArrayLike
 
 from ...errors import InvalidProblemError
-from ..localisation import localise_indexed, pseudo_measurements, wrap_angle
+from ..localisation import localise_indexed, pseudo_measurements
 from ...problem import AssignmentProblem
-from . import kld as dv
+from .data_terms import data_term
 from .pattipati import NORMALISATIONS, constant_terms
 
 __all__ = ["Scan", "COSTS", "PRINTED_COSTS", "candidate_tuples", "TupleGeometry",
@@ -42,14 +42,24 @@ __all__ = ["Scan", "COSTS", "PRINTED_COSTS", "candidate_tuples", "TupleGeometry"
 #: sensor's [alpha, beta] pair, without (26).
 COSTS: dict[str, str] = {
     "pattipati": "eq. (7): 1/2 Delta^T R^-1 Delta with the LS position (ref. [2] of paper 002)",
-    "kld-printed": "eqs. (24)+(26)+(27) exactly as printed (not a KL divergence)",
-    "skld-printed": "eqs. (25)+(26)+(28) exactly as printed (not the symmetric KL)",
-    "kld-exact": "eqs. (24)+(26) with the exact 1-D Gaussian KL divergence",
-    "skld-exact": "eqs. (25)+(26) with the exact 1-D symmetric KL divergence",
+    "kld-printed": "eqs. (24)+(26)+(27) exactly as printed (not a KL divergence: negative "
+                   "when s~ < s)",
+    "skld-printed": "eqs. (25)+(26)+(28) exactly as printed (not the symmetric KL: no "
+                    "variance term)",
+    "kld-exact": "eqs. (24)+(26) with the exact 1-D Gaussian KL divergence "
+                 "KL(pseudo-measurement || measurement)",
+    "skld-exact": "eqs. (25)+(26) with the exact 1-D symmetric KL (Jeffreys) divergence",
     "kld-joint": "eq. (24) with the exact 2-D Gaussian KL of each sensor's (alpha, beta)",
     "skld-joint": "eq. (25) with the exact 2-D Gaussian symmetric KL of each sensor's "
                   "(alpha, beta)",
+    "pattipati-ml": "eq. (7) with the maximum-likelihood position (iterated LS, Gauss-Newton) "
+                    "instead of the one-step LS (14)",
+    "kld-reversed": "eqs. (24)+(26) with the exact 1-D KL divergence, arguments swapped: "
+                    "KL(measurement || pseudo-measurement), mean difference weighted by "
+                    "1/s~^2",
 }
+#: Costs that localise with their own method, whatever the run's ``localiser``.
+COST_LOCALISER: dict[str, str] = {"pattipati-ml": "ils"}
 #: The costs as the paper prints them (what its tables report).
 PRINTED_COSTS = ("pattipati", "kld-printed", "skld-printed")
 
@@ -274,56 +284,6 @@ class SDCosts:
     options: dict = field(default_factory=dict)
 
 
-def _components(g: TupleGeometry):
-    """(K, N) component arrays shared by every data term (computed once per geometry)."""
-    cached = g.cache.get("components")
-    if cached is not None:
-        return cached
-    delta = g.pm_mean - g.meas
-    if delta.shape[-1] == 1:
-        # azimuth only: a neutral elevation slot (zero difference, unit variances, no
-        # correlation) contributes exactly 0 to every data term below
-        zero, one = np.zeros(delta.shape[:-1]), np.ones(delta.shape[:-1])
-        comp = dict(da=zero, db=wrap_angle(delta[..., 0]), ra=one, rb=g.R[..., 0, 0],
-                    rab=zero, ta=one, tb=g.pm_cov[..., 0, 0], tab=zero)
-        g.cache["components"] = comp
-        return comp
-    da = delta[..., 0]
-    db = wrap_angle(delta[..., 1])
-    comp = dict(da=da, db=db, ra=g.R[..., 0, 0], rb=g.R[..., 1, 1], rab=g.R[..., 0, 1],
-                ta=g.pm_cov[..., 0, 0], tb=g.pm_cov[..., 1, 1], tab=g.pm_cov[..., 0, 1])
-    g.cache["components"] = comp
-    return comp
-
-
-def _data_term(g: TupleGeometry, method: str) -> np.ndarray:
-    """Per tuple: sum over real sensors of 1/2 (statistical distance or divergence)."""
-    c = _components(g)
-    da, db, ra, rb, rab = c["da"], c["db"], c["ra"], c["rb"], c["rab"]
-    with np.errstate(invalid="ignore", divide="ignore", over="ignore"):
-        if method == "pattipati":
-            det_r = ra * rb - rab * rab
-            per = (rb * da * da - 2.0 * rab * da * db + ra * db * db) / det_r
-        elif method.endswith("-joint"):
-            ta, tb, tab = c["ta"], c["tb"], c["tab"]
-            det_r = ra * rb - rab * rab
-            det_t = ta * tb - tab * tab
-            tr_rt = (rb * ta - 2.0 * rab * tab + ra * tb) / det_r       # tr(R^-1 S~)
-            maha_r = (rb * da * da - 2.0 * rab * da * db + ra * db * db) / det_r
-            if method == "kld-joint":
-                per = 0.5 * (tr_rt + maha_r - 2.0 + np.log(det_r / det_t))
-            else:
-                tr_tr = (tb * ra - 2.0 * tab * rab + ta * rb) / det_t   # tr(S~^-1 R)
-                maha_t = (tb * da * da - 2.0 * tab * da * db + ta * db * db) / det_t
-                per = 0.5 * (tr_rt + tr_tr - 4.0 + maha_r + maha_t)
-        else:
-            fn = {"kld-printed": dv.kld_printed, "skld-printed": dv.skld_printed,
-                  "kld-exact": dv.kld_exact, "skld-exact": dv.skld_exact}[method]
-            # (26): elevation and azimuth treated as independent scalar Gaussians
-            per = fn(da, c["ta"], 0.0, ra) + fn(db, c["tb"], 0.0, rb)
-    return 0.5 * np.where(g.mask, per, 0.0).sum(axis=1)
-
-
 def tuple_costs(scan: Scan, geometry: TupleGeometry, method: str, *,
                 normalisation: str = "printed", const: np.ndarray | None = None) -> SDCosts:
     """Cost of every tuple of ``geometry`` for the named ``method`` (see :data:`COSTS`).
@@ -337,7 +297,7 @@ def tuple_costs(scan: Scan, geometry: TupleGeometry, method: str, *,
     if const is None:
         const = _constants(scan, g, normalisation)
     n_real = g.n_real
-    data = _data_term(g, method)
+    data = data_term(g, method)
     bad = ((n_real >= 2) & ~g.valid) | ~np.isfinite(data)
     data = np.where(n_real == 1, 0.0, data)        # false-alarm tuple: cost 0 (our convention)
     data = np.where(bad, np.inf, data)
@@ -370,10 +330,18 @@ def build_costs(scan: Scan, methods: Sequence[str] = tuple(COSTS), *, localiser:
     for m in methods:
         if m not in COSTS:
             raise InvalidProblemError(f"unknown cost {m!r}; valid: {', '.join(COSTS)}")
-    geom = tuple_geometry(scan, localiser=localiser, covariance=covariance)
-    const = _constants(scan, geom, normalisation)
-    return {m: tuple_costs(scan, geom, m, normalisation=normalisation, const=const)
-            for m in methods}
+    geoms: dict[str, TupleGeometry] = {}
+    out: dict[str, SDCosts] = {}
+    const = None
+    for m in methods:
+        loc = COST_LOCALISER.get(m, localiser)
+        if loc not in geoms:
+            geoms[loc] = tuple_geometry(scan, localiser=loc, covariance=covariance)
+        g = geoms[loc]
+        if const is None:                  # the constants depend on the tuples and R only
+            const = _constants(scan, g, normalisation)
+        out[m] = tuple_costs(scan, g, m, normalisation=normalisation, const=const)
+    return out
 
 
 def build_problem(scan: Scan, method: str = "pattipati", *, costs: SDCosts | None = None,

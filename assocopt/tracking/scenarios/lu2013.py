@@ -25,7 +25,7 @@ from ..costs.sd_builder import Scan
 from ...errors import InvalidProblemError
 from ..localisation import angles
 
-__all__ = ["Lu2013", "Truth", "PAPER_SENSORS_KM", "PAPER", "OURS"]
+__all__ = ["Lu2013", "Truth", "PAPER_SENSORS_KM", "PAPER", "OURS", "REPRODUCTION_REGION_KM"]
 
 #: Sensor positions of §4 (km).
 PAPER_SENSORS_KM = ((0.0, 20.0, 0.0), (20.0, 0.0, 0.0), (0.0, 0.0, 0.0))
@@ -41,6 +41,9 @@ PAPER = {
     "table_M": [5, 10, 15, 20],
     "table_d": [0.5, 1.0, 1.5],
 }
+
+#: The observation region of ``assocopt reproduce lu2013`` (km; the paper gives none).
+REPRODUCTION_REGION_KM = ((0.0, 50.0), (0.0, 50.0), (1.0, 10.0))
 
 #: Parameters the paper does not give; our choices are the dataclass defaults.
 OURS = ("region_km", "line_direction", "d_unit", "sigma_same_for_both_angles",
@@ -93,11 +96,19 @@ class Lu2013:
     d : float
         Spacing between neighbouring targets, km (unit ours: not printed).
     sigma_mrad : float
-        Angle noise standard deviation (azimuth and elevation alike, ours), mrad.
+        Angle noise standard deviation, mrad (of the azimuth, and of the elevation
+        too unless ``sigma_elevation_mrad`` is given).
+    sigma_elevation_mrad : float or None
+        Elevation noise standard deviation, mrad; ``None`` (default, ours: the paper
+        gives one sigma) means the same as ``sigma_mrad``.
     sensors_km : tuple of (x, y, z)
         Sensor positions; the paper's three by default (more sensors allowed).
     region_km : ((x0, x1), (y0, y1), (z0, z1))
-        Box in which the first target is drawn uniformly (ours: not given).
+        Box in which the first target is drawn uniformly (ours: not given).  The
+        default is a wide field around the sensors, used by the benchmarks
+        (``benchmarks/sd_scaling.py``); it is **not** the reproduction's region:
+        ``assocopt reproduce lu2013`` uses [0, 50] x [0, 50] x [1, 10] km
+        (:data:`REPRODUCTION_REGION_KM`, see ``docs/papers/lu2013.md``).
     line_direction : {"x", "horizontal", "3d"}
         Direction of the line of targets: along +x as the pair of §4.1 (ours),
         uniformly random in the horizontal plane, or uniformly random in 3-D.
@@ -118,6 +129,7 @@ class Lu2013:
     n_targets: int = 2
     d: float = 1.0
     sigma_mrad: float = 1.5
+    sigma_elevation_mrad: float | None = None
     sensors_km: tuple = PAPER_SENSORS_KM
     region_km: tuple = ((-90.0, 110.0), (-90.0, 110.0), (1.0, 20.0))
     line_direction: str = "x"
@@ -132,6 +144,9 @@ class Lu2013:
             raise InvalidProblemError(f"d must be a finite number >= 0, got {self.d}")
         if not self.sigma_mrad > 0:
             raise InvalidProblemError(f"sigma_mrad must be > 0, got {self.sigma_mrad}")
+        if self.sigma_elevation_mrad is not None and not self.sigma_elevation_mrad > 0:
+            raise InvalidProblemError(
+                f"sigma_elevation_mrad must be > 0 or None, got {self.sigma_elevation_mrad}")
         if not 0 < self.pd <= 1:
             raise InvalidProblemError(f"pd must lie in (0, 1], got {self.pd}")
         if not self.clutter_rate >= 0:
@@ -152,6 +167,16 @@ class Lu2013:
         return self.sigma_mrad * 1e-3
 
     @property
+    def sigma_same_for_both_angles(self) -> bool:
+        return self.sigma_elevation_mrad is None or self.sigma_elevation_mrad == self.sigma_mrad
+
+    @property
+    def sigmas_rad(self) -> np.ndarray:
+        """Noise standard deviations ``[elevation, azimuth]``, rad."""
+        el = self.sigma_mrad if self.sigma_elevation_mrad is None else self.sigma_elevation_mrad
+        return np.array([el, self.sigma_mrad]) * 1e-3
+
+    @property
     def fov_area(self) -> float:
         """Angular area of the field of view, rad^2 (elevation span x azimuth span)."""
         (e0, e1), (a0, a1) = self.fov_rad
@@ -161,7 +186,7 @@ class Lu2013:
         """Every parameter, as JSON-ready values, with the ones that are ours listed."""
         p = asdict(self)
         p["d_unit"] = "km"
-        p["sigma_same_for_both_angles"] = True
+        p["sigma_same_for_both_angles"] = self.sigma_same_for_both_angles
         p["ours"] = list(OURS)
         return p
 
@@ -190,7 +215,7 @@ class Lu2013:
         N = len(S)
         X = self.place_targets(rng)
         theta = angles(X, S)                                   # (M, N, 2)
-        sig = self.sigma_rad
+        sig = self.sigmas_rad                                  # [elevation, azimuth]
         meas, labels = [], []
         (e0, e1), (a0, a1) = self.fov_rad
         for s in range(N):
@@ -209,7 +234,7 @@ class Lu2013:
             m[:, 1] = np.mod(m[:, 1] + math.pi, 2 * math.pi) - math.pi
             meas.append(m)
             labels.append(lab[order].astype(np.int64))
-        R = np.eye(2) * sig ** 2
+        R = np.diag(sig ** 2)
         density = self.clutter_rate / self.fov_area if self.clutter_rate > 0 else 0.0
         scan = Scan.create(S, meas, R, pd=self.pd, clutter_density=density)
         return scan, Truth(targets=X, labels=tuple(labels))

@@ -54,7 +54,7 @@ PAPER = {
 
 #: Parameters the paper does not give; our choices are the dataclass defaults.
 OURS = ("region", "type_assignment", "confusion_size", "confusion_includes_true",
-        "noise_reference", "shuffle")
+        "noise_reference", "shuffle", "covariance_scale")
 
 TYPE_NAMES = tuple(f"type{k}" for k in range(1, 7))
 
@@ -140,6 +140,10 @@ class Zhang2009:
         Probability of attribute generator 1 (paper: 1/2).
     shuffle : bool
         Put each sensor's observations in random order (ours: True).
+    covariance_scale : float
+        The position covariance the matcher is given, as a multiple of the true noise
+        covariance ``sigma^2 I`` (ours: 1, the true one; the paper does not say which
+        covariance enters d^2).  The noise actually drawn is always ``sigma^2 I``.
     """
 
     f: float = 0.3
@@ -153,6 +157,7 @@ class Zhang2009:
     noise_reference: str = "per_run"
     generator_probability: float = 0.5
     shuffle: bool = True
+    covariance_scale: float = 1.0
 
     def __post_init__(self) -> None:
         if not (isinstance(self.f, (int, float)) and self.f > 0):
@@ -177,6 +182,9 @@ class Zhang2009:
                              f"got {self.noise_reference!r}")
         if len(self.region) != 2 or min(self.region) <= 0:
             raise ValueError(f"region must be (width, height) > 0, got {self.region!r}")
+        if not (isinstance(self.covariance_scale, (int, float)) and self.covariance_scale > 0):
+            raise ValueError(f"covariance_scale must be a positive number, "
+                             f"got {self.covariance_scale!r}")
         if not 0.0 <= self.generator_probability <= 1.0:
             raise ValueError("generator_probability must be in [0, 1]")
         object.__setattr__(self, "region", tuple(float(v) for v in self.region))
@@ -203,7 +211,7 @@ class Zhang2009:
                else _expected_mean_nearest(n, self.region))
         sigma = self.f * ref
         conf = confusion_sets(T, self.confusion_size, self.confusion_includes_true)
-        cov = sigma * sigma * np.eye(2)
+        cov = self.covariance_scale * sigma * sigma * np.eye(2)    # as given to the matcher
 
         parts = []
         for _ in (1, 2):

@@ -1,0 +1,63 @@
+"""What a reproduction records about its own runs: wall time of every invocation that
+computed trials, and the compute time stored with the trials themselves.
+
+Both go into ``summary.json``, so the wall times a paper page quotes come from the
+command's output, not from a note taken by hand.
+"""
+
+from __future__ import annotations
+
+import json
+import sqlite3
+from pathlib import Path
+from typing import Any, Mapping, Sequence
+
+__all__ = ["timing_history", "trial_seconds"]
+
+
+def timing_history(previous_summary: Path, timing: Mapping[str, Mapping[str, Any]], *,
+                   runs: int, workers: int, seed: int,
+                   options: Mapping[str, Any] | None = None) -> list[dict[str, Any]]:
+    """The invocations into one output folder that computed trials, oldest first.
+
+    ``previous_summary`` is the folder's ``summary.json`` before this invocation (its
+    ``timing_history`` is kept; an older summary without one contributes its
+    ``timing``); this invocation's ``timing`` is appended when it ran any trial.
+    """
+    hist: list[dict[str, Any]] = []
+    try:
+        old = json.loads(Path(previous_summary).read_text())
+    except (OSError, ValueError):
+        old = None
+    if old is not None:
+        if "timing_history" in old:
+            hist = list(old["timing_history"])
+        elif isinstance(old.get("timing"), dict) and any(
+                t.get("done") for t in old["timing"].values()):
+            hist = [{"runs": old.get("runs"), "workers": old.get("workers"),
+                     "seed": old.get("seed"), "options": {}, "experiments": old["timing"]}]
+    if any(t.get("done") for t in timing.values()):
+        hist.append({"runs": runs, "workers": workers, "seed": seed,
+                     "options": dict(options or {}),
+                     "experiments": {k: dict(v) for k, v in timing.items()}})
+    return hist
+
+
+def trial_seconds(out: Path, names: Sequence[str]) -> dict[str, dict[str, float]]:
+    """Per experiment store ``out/NAME.sqlite``: trials stored and the sum of their
+    compute seconds (measured in the worker around each trial; one value per trial,
+    shared by its methods)."""
+    res = {}
+    for name in names:
+        path = Path(out) / f"{name}.sqlite"
+        if not path.exists():
+            continue
+        con = sqlite3.connect(f"file:{path}?mode=ro", uri=True)
+        try:
+            n, s = con.execute(
+                "SELECT COUNT(*), SUM(sec) FROM (SELECT MAX(seconds) AS sec FROM trials "
+                "GROUP BY setting_id, trial)").fetchone()
+        finally:
+            con.close()
+        res[name] = {"trials": int(n or 0), "seconds": float(s or 0.0)}
+    return res
