@@ -15,6 +15,7 @@ from .solution import Solution, Status
 from .solvers.base import (Backend, RawResult, SolveOptions, check_capabilities,
                            empty_answer, get_backend, module_installed)
 from .solvers.kernels import spent
+from .twod import _finite_amax
 
 __all__ = ["solve", "choose_solver", "BNB_MAX_CANDIDATES"]
 
@@ -146,21 +147,11 @@ _SCALE_TO_EXPONENT = 40
 
 def _max_abs_cost(problem: AssignmentProblem) -> float:
     """Largest finite |cost|; for a dense 2-D problem read from its matrix (the
-    candidate list is not built for it)."""
+    candidate list is not built for it), reusing what its validation found."""
     d = problem.dense_view
-    arrays = [problem.costs] if d is None else [d.C, d.rm, d.cm]
-    m = 0.0
-    for a in arrays:
-        if a.size == 0:
-            continue
-        hi, lo = float(a.max()), float(a.min())
-        if not (math.isfinite(hi) and math.isfinite(lo)):
-            a = a[np.isfinite(a)]
-            if a.size == 0:
-                continue
-            hi, lo = float(a.max()), float(a.min())
-        m = max(m, hi, -lo)
-    return m
+    if d is not None:
+        return d.max_abs_cost()
+    return _finite_amax(problem.costs)
 
 
 def _solve_scaled(backend: Backend, problem: AssignmentProblem,

@@ -107,10 +107,11 @@ class AssignmentProblem(IndexArithmetic):
         scipy's ``maximize``; ``-inf`` is then forbidden.  A 2-D matrix is kept as
         given (no candidate list until a back end needs one).
         """
-        C, all_finite = _as_matrix(costs, "cost array", maximize)
+        C, all_finite, amax = _as_matrix(costs, "cost array", maximize)
         if C.ndim == 2:
-            return from_matrix(cls, C, None, None, all_finite, kind="dense", name=name,
-                                    optimum=optimum, maximize=maximize)
+            return from_matrix(cls, C, None, None, all_finite, amax=(amax, 0.0, 0.0),
+                               kind="dense", name=name, optimum=optimum,
+                               maximize=maximize)
         _reject_non_finite(C, "cost array", maximize)
         if C.ndim < 2:
             raise InvalidProblemError(
@@ -150,17 +151,18 @@ class AssignmentProblem(IndexArithmetic):
         fully assigned); with only one given, the other side must be assigned.
         ``maximize=True``: matrix and misses are scores to maximise (``-inf`` forbids).
         """
-        C, all_finite = _as_matrix(costs, "cost matrix", maximize)
+        C, all_finite, amax = _as_matrix(costs, "cost matrix", maximize)
         if C.ndim != 2:
             raise InvalidProblemError(f"cost matrix must be 2-D, got shape {C.shape}")
         if row_miss is None and col_miss is None:
-            return from_matrix(cls, C, None, None, all_finite, kind="dense", name=name,
-                                    optimum=optimum, maximize=maximize)
+            return from_matrix(cls, C, None, None, all_finite, amax=(amax, 0.0, 0.0),
+                               kind="dense", name=name, optimum=optimum,
+                               maximize=maximize)
         n1, n2 = C.shape
-        (rm, fr), (cm, fc) = (miss_vector(row_miss, n1, "row_miss", maximize),
-                              miss_vector(col_miss, n2, "col_miss", maximize))
-        return from_matrix(cls, C, rm, cm, all_finite, (fr, fc), kind="two_d", name=name,
-                           optimum=optimum, maximize=maximize)
+        (rm, fr, ar), (cm, fc, ac) = (miss_vector(row_miss, n1, "row_miss", maximize),
+                                      miss_vector(col_miss, n2, "col_miss", maximize))
+        return from_matrix(cls, C, rm, cm, all_finite, (fr, fc), amax=(amax, ar, ac),
+                           kind="two_d", name=name, optimum=optimum, maximize=maximize)
 
     @property
     def dense_view(self) -> Any:

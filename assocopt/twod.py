@@ -26,6 +26,10 @@ from typing import Any, NamedTuple
 
 import numpy as np
 
+from .errors import InvalidProblemError
+from .validation import MAX_ABS_COST
+from .values import _as_matrix
+
 __all__ = ["Dense2D", "Checked", "LazyView", "from_matrix", "miss_vector",
            "MAX_DENSE_CANDIDATES"]
 
@@ -38,13 +42,14 @@ MAX_DENSE_CANDIDATES = 50_000_000
 
 def from_matrix(cls: type, C: np.ndarray, rm: np.ndarray | None, cm: np.ndarray | None,
                 all_finite: bool, known_finite: tuple[bool, bool] = (False, False),
+                amax: tuple[float | None, float | None, float | None] = (None, None, None),
                 **kw: Any) -> Any:
     """A 2-D ``AssignmentProblem`` kept as its dense matrix (``C`` validated, owned).
 
-    Filled in directly rather than through the dataclass's generated ``__init__``: this
-    is the per-scan hot path, where every microsecond is measured against scipy."""
-    from .errors import InvalidProblemError
-
+    ``amax``: the largest finite magnitude of ``C``, ``rm``, ``cm`` where the
+    validation found it (None: computed when needed).  Filled in directly rather than
+    through the dataclass's generated ``__init__``: this is the per-scan hot path,
+    where every microsecond is measured against scipy."""
     if C.size > MAX_DENSE_CANDIDATES:
         raise InvalidProblemError(
             f"cost matrix of shape {C.shape} has {C.size} entries, more than "
@@ -53,7 +58,8 @@ def from_matrix(cls: type, C: np.ndarray, rm: np.ndarray | None, cm: np.ndarray 
     p.__dict__.update({"sizes": C.shape, "_tuples": None, "_costs": None, "_slack": None,
                        "name": None, "optimum": None, "meta": {}, "maximize": False,
                        "kind": "sparse",
-                       "_dense": Dense2D.build(C, rm, cm, all_finite, known_finite)},
+                       "_dense": Dense2D.build(C, rm, cm, all_finite, known_finite,
+                                              amax)},
                       **kw)
     return p
 
@@ -98,23 +104,23 @@ def _arange(n: int) -> np.ndarray:
     return a
 
 
-def miss_vector(values: Any, n: int, what: str, maximize: bool) -> tuple[np.ndarray, bool]:
-    """A validated miss-cost vector (minimisation sense; None: all forbidden) and
-    whether it is known to be all finite (a finite scalar: a shared constant)."""
-    from .errors import InvalidProblemError
-    from .values import _as_cost_array
-
+def miss_vector(values: Any, n: int, what: str, maximize: bool
+                ) -> tuple[np.ndarray, bool, float | None]:
+    """A validated miss-cost vector (minimisation sense; None: all forbidden), whether
+    it is known to be all finite, and then its largest magnitude (else None)."""
     if values is None:
-        return _constant(n, np.inf), False
-    if isinstance(values, (int, float)) and math.isfinite(values):
-        return _constant(n, -float(values) if maximize else float(values)), True
-    arr = _as_cost_array(values, what, maximize)
+        return _constant(n, np.inf), False, 0.0
+    if isinstance(values, (int, float)) and not isinstance(values, bool) and \
+            abs(values) <= MAX_ABS_COST:       # a finite scalar in range: a constant
+        v = -float(values) if maximize else float(values)
+        return _constant(n, v), True, abs(v)
+    arr, finite, amax = _as_matrix(values, what, maximize)
     if arr.ndim == 0:
-        return np.full(n, float(arr)), False
+        return np.full(n, float(arr)), finite, amax
     if arr.shape != (n,):
         raise InvalidProblemError(f"{what} must be a scalar or have shape ({n},), "
                                   f"got shape {arr.shape}")
-    return arr, False
+    return arr, finite, amax
 
 
 def _finite_index(a: np.ndarray) -> np.ndarray:
@@ -123,6 +129,19 @@ def _finite_index(a: np.ndarray) -> np.ndarray:
     if math.isfinite(a.sum()):
         return _arange(len(a))
     return np.isfinite(a).nonzero()[0]
+
+
+def _finite_amax(a: np.ndarray) -> float:
+    """Largest finite ``|a|`` (0 when there is none)."""
+    if a.size == 0:
+        return 0.0
+    hi, lo = float(a.max()), float(a.min())
+    if not (math.isfinite(hi) and math.isfinite(lo)):
+        a = a[np.isfinite(a)]
+        if a.size == 0:
+            return 0.0
+        hi, lo = float(a.max()), float(a.min())
+    return max(hi, -lo, 0.0)
 
 
 class Checked(NamedTuple):
@@ -141,25 +160,32 @@ class Dense2D:
     ``all_finite``: no forbidden matrix entry; ``n_pairs``: number of finite entries;
 
     ``miss_index``: the rows and the columns whose miss is a candidate (finite cost);
-    ``miss_flags``: ``(all rm finite, all cm finite)``.  Read-only by convention (a
-    plain class: built once per scan, where a frozen dataclass's ``__init__`` costs).
+    ``miss_flags``: ``(all rm finite, all cm finite)``; ``amax``: the largest finite
+    magnitude of ``C``, ``rm``, ``cm`` where known (see :meth:`max_abs_cost`).
+    Read-only by convention (a plain class: built once per scan, where a frozen
+    dataclass's ``__init__`` costs).
     """
 
     def __init__(self, C: np.ndarray, rm: np.ndarray, cm: np.ndarray, slack: bool,
                  all_finite: bool, n_pairs: int,
                  miss_index: tuple[np.ndarray, np.ndarray],
-                 miss_flags: tuple[bool, bool]) -> None:
+                 miss_flags: tuple[bool, bool],
+                 amax: tuple[float | None, float | None, float | None] = (None, None, None)
+                 ) -> None:
         self.C, self.rm, self.cm, self.slack = C, rm, cm, slack
         self.all_finite, self.n_pairs = all_finite, n_pairs
         self.miss_index, self.miss_flags = miss_index, miss_flags
+        self.amax = amax
         self._rank: np.ndarray | None = None
 
     @classmethod
     def build(cls, C: np.ndarray, rm: np.ndarray | None, cm: np.ndarray | None,
-              all_finite: bool, known_finite: tuple[bool, bool] = (False, False)
+              all_finite: bool, known_finite: tuple[bool, bool] = (False, False),
+              amax: tuple[float | None, float | None, float | None] = (None, None, None)
               ) -> "Dense2D":
         """From a validated matrix; ``rm = cm = None`` means the ``dense`` kind;
-        ``known_finite``: the caller knows all of ``rm`` / ``cm`` is finite (scalars)."""
+        ``known_finite``: the caller knows all of ``rm`` / ``cm`` is finite (scalars);
+        ``amax``: the magnitudes the validation found (None: not known)."""
         n1, n2 = C.shape
         slack = rm is None and cm is None
         if slack:      # the larger side's surplus is free: known without looking
@@ -175,7 +201,20 @@ class Dense2D:
             cm.setflags(write=False)
         n_pairs = C.size if all_finite else int(np.count_nonzero(np.isfinite(C)))
         C.setflags(write=False)
-        return cls(C, rm, cm, slack, all_finite, n_pairs, index, flags)
+        if slack:      # the slack misses are 0 or forbidden: magnitude 0
+            amax = (amax[0], 0.0, 0.0)
+        return cls(C, rm, cm, slack, all_finite, n_pairs, index, flags, amax)
+
+    def max_abs_cost(self) -> float:
+        """Largest finite ``|cost|`` of the matrix and the misses (0 when none): the
+        cost-scaling test of :func:`assocopt.solve`; the magnitudes the validation
+        already found are reused, the others computed (and kept) here."""
+        known = self.amax
+        if None in known:
+            known = tuple(_finite_amax(a) if m is None else m
+                          for a, m in zip((self.C, self.rm, self.cm), known))
+            self.amax = known
+        return max(known)
 
     @property
     def shape(self) -> tuple[int, int]:

@@ -1,8 +1,8 @@
 """Cost values: one bulk validation for every constructor.
 
 Every constructor turns its values into a fresh float64 array in the minimisation sense
-(negated for ``maximize=True``), tests it once (its sum is finite) and only when
-that fails looks for what is wrong: NaN, or the infinity that does not mean "forbidden"
+(negated for ``maximize=True``), tests it once (its minimum and maximum lie within
+``validation.MAX_ABS_COST``) and only when that fails looks for what is wrong: NaN, or the infinity that does not mean "forbidden"
 (``-inf`` for costs, ``+inf`` for scores).  Complex, boolean and text data and finite
 magnitudes beyond ``validation.MAX_ABS_COST`` (1e300) are rejected first.
 """
@@ -15,7 +15,7 @@ import numpy as np
 from numpy.typing import ArrayLike
 
 from .errors import InvalidProblemError
-from .validation import check_cost_dtype, check_cost_range
+from .validation import MAX_ABS_COST, check_cost_dtype, check_cost_range
 
 __all__ = ["_as_cost_array", "_as_matrix", "_reject_non_finite"]
 
@@ -40,17 +40,35 @@ def _reject_non_finite(arr: np.ndarray, what: str, maximize: bool) -> None:
                                   f"{ok} means forbidden{extra}")
 
 
-def _as_matrix(values: ArrayLike, what: str, maximize: bool) -> tuple[np.ndarray, bool]:
-    """A fresh float64 array in the minimisation sense and whether all of it is finite;
-    NaN and the wrong infinity are rejected (checked only when not all finite)."""
-    raw = check_cost_dtype(values, what)      # complex, booleans, text, huge integers
-    arr = np.array(raw, dtype=np.float64)
+def _as_matrix(values: ArrayLike, what: str, maximize: bool
+               ) -> tuple[np.ndarray, bool, float | None]:
+    """A fresh float64 array in the minimisation sense, whether all of it is finite,
+    and, when it is, its largest magnitude (None otherwise); NaN and the wrong
+    infinity are rejected (looked for only when not all finite).
+
+    The common case (a float64 array, all finite, in range) costs a copy and two
+    reductions: ``min`` and ``max`` inside ``[-MAX_ABS_COST, MAX_ABS_COST]`` prove
+    the range, the absence of NaN (which fails every comparison) and of infinities at
+    once, and give the magnitude the solve's cost-scaling test needs."""
+    if type(values) is np.ndarray and values.dtype.char == "d":
+        arr = np.array(values, dtype=np.float64)       # the hot path: no dtype checks
+    else:
+        raw = check_cost_dtype(values, what)  # complex, booleans, text, huge integers
+        arr = np.array(raw, dtype=np.float64)
+    if arr.size:
+        lo = float(_MIN(arr, axis=None))
+        hi = float(_MAX(arr, axis=None))
+        if -MAX_ABS_COST <= lo and hi <= MAX_ABS_COST:
+            if maximize:
+                np.negative(arr, out=arr)
+            return arr, True, max(hi, -lo)
+    else:
+        return arr, True, 0.0
     check_cost_range(arr, what)               # |c| <= MAX_ABS_COST: no sum can overflow
     if maximize:
         np.negative(arr, out=arr)
-    # One pass, no temporary: a finite sum means no NaN and no infinity (a huge but
-    # finite matrix may overflow the sum; then the exact test decides).
-    if math.isfinite(arr.sum()) or np.isfinite(arr).all():
-        return arr, True
     _reject_non_finite(arr, what, maximize)
-    return arr, False
+    return arr, False, None
+
+
+_MIN, _MAX = np.minimum.reduce, np.maximum.reduce
