@@ -97,7 +97,7 @@ def solve(problem: AssignmentProblem, solver: str = "auto", *, relax: str | None
     if not isinstance(problem, AssignmentProblem):
         raise InvalidProblemError(
             f"problem must be an AssignmentProblem, got {type(problem).__name__}")
-    if relax not in (None, "lp"):
+    if relax is not None and relax != "lp":
         raise InvalidProblemError(f"relax must be None or 'lp', got {relax!r}")
     name = choose_solver(problem, relax) if solver == "auto" else solver
     backend_cls = get_backend(name)
@@ -105,36 +105,47 @@ def solve(problem: AssignmentProblem, solver: str = "auto", *, relax: str | None
     if backend_cls.module is not None and not module_installed(backend_cls.module):
         backend_cls.require()        # cached lookup first: a scan's solve is microseconds
     parsed = backend_cls.parse_options(options)
-    # SolveOptions checks the common options (the one place that does)
-    opts = SolveOptions(relax=relax, time_limit=time_limit, mip_gap=mip_gap,
-                        threads=threads, verbose=verbose, extra=parsed, parsed=True)
+    if time_limit is None and threads is None and verbose is False and \
+            type(mip_gap) is float and mip_gap == 0.0:
+        opts = SolveOptions.parsed_defaults(relax, parsed)    # nothing to check
+    else:       # SolveOptions checks the common options (the one place that does)
+        opts = SolveOptions(relax=relax, time_limit=time_limit, mip_gap=mip_gap,
+                            threads=threads, verbose=verbose, extra=parsed, parsed=True)
 
-    n_missing = problem.n_uncovered
-    if n_missing:
-        missing = problem.uncovered(limit=20)
-        a, i = missing[0]
-        more = f" (and {n_missing - 1} more)" if n_missing > 1 else ""
-        raw = RawResult(Status.INFEASIBLE,
-                        message=f"infeasible: {index_label(a, i)} is covered by no "
-                                f"candidate{more}",
-                        info={"uncovered": missing})
+    if problem.n_uncovered:
+        raw = _uncovered_answer(problem)
     elif problem.n_rows == 0:
         raw = empty_answer(problem, opts)
     else:
         k0 = spent()
         raw = _solve_scaled(backend_cls(), problem, opts)
-        _kernel_times(raw, k0)
+        k1 = spent()
+        if k1 != k0:
+            _kernel_times(raw, k0, k1)
     sol = _finalise(problem, backend_cls, raw, relax)
     sol.info.setdefault("options", parsed)
     sol.times["total"] = time.perf_counter() - t0
     return sol
 
 
-def _kernel_times(raw: RawResult, before: tuple[float, float]) -> None:
+def _uncovered_answer(problem: AssignmentProblem) -> RawResult:
+    """The infeasible answer of a problem with real indices no candidate covers."""
+    n_missing = problem.n_uncovered
+    missing = problem.uncovered(limit=20)
+    a, i = missing[0]
+    more = f" (and {n_missing - 1} more)" if n_missing > 1 else ""
+    return RawResult(Status.INFEASIBLE,
+                     message=f"infeasible: {index_label(a, i)} is covered by no "
+                             f"candidate{more}",
+                     info={"uncovered": missing})
+
+
+def _kernel_times(raw: RawResult, before: tuple[float, float],
+                  after: tuple[float, float]) -> None:
     """Record the numba compilation / disk-cache loading done during a solve (the
     back ends leave it out of their build and solve times) as ``compile_time`` and
     ``cache_load_time`` in ``raw.info``; the Solution shows them in ``times``."""
-    compiled, loaded = (a - b for a, b in zip(spent(), before))
+    compiled, loaded = (a - b for a, b in zip(after, before))
     if compiled > 0 or loaded > 0:
         raw.info = dict(raw.info, compile_time=compiled, cache_load_time=loaded)
 #: Costs larger than this in magnitude are scaled by a power of two before a back end

@@ -376,20 +376,40 @@ class Dense2D:
 
     def _check_permutation(self, cor: np.ndarray) -> Checked | str:
         """:meth:`check` for a square problem without misses: ``cor`` a permutation
-        (checked on the Python list: faster than numpy reductions for a scan's few
-        rows, negligible beside the LAP for many)."""
+        (checked as a Python set against the cached ``{0, ..., n-1}``: faster than numpy
+        reductions for a scan's few rows, negligible beside the LAP for many)."""
         n = len(cor)
-        lst = cor.tolist()
-        if n and (min(lst) < 0 or max(lst) >= n or len(set(lst)) != n):
+        if set(cor.tolist()) != _index_set(n):
             return "the answer is not a permutation of the columns"
-        rows = _arange(n)
-        flat = rows * n + cor
+        flat = _row_offsets(n, n) + cor
         objective = math.fsum(self.C.take(flat).tolist())
         if not math.isfinite(objective):
             return "the answer uses a forbidden pair"
         selected = flat if self._pair_rank is None else self._pair_rank[flat]
-        tuples = np.empty((n, 2), np.int64)
-        tuples[:, 0] = rows
-        tuples[:, 1] = cor
-        tuples += 1
+        tuples = _pair_base(n).copy()       # rows 1..n in column 0, 1 in column 1
+        tuples[:, 1] += cor
         return Checked(selected, objective, tuples)
+
+
+@functools.lru_cache(maxsize=256)
+def _index_set(n: int) -> frozenset[int]:
+    """``{0, ..., n-1}``: the values of a permutation of ``n`` items."""
+    return frozenset(range(n))
+
+
+@functools.lru_cache(maxsize=256)
+def _row_offsets(n1: int, n2: int) -> np.ndarray:
+    """``i * n2`` for each row ``i``: flat row-major index of row ``i``'s first entry."""
+    a = np.arange(n1, dtype=np.int64) * n2
+    a.setflags(write=False)
+    return a
+
+
+@functools.lru_cache(maxsize=256)
+def _pair_base(n: int) -> np.ndarray:
+    """``[[1, 1], [2, 1], ..., [n, 1]]``: the reported pairs of rows ``1..n`` before
+    their 0-based columns are added to column 1 (copied, never written)."""
+    a = np.ones((n, 2), np.int64)
+    a[:, 0] = np.arange(1, n + 1)
+    a.setflags(write=False)
+    return a

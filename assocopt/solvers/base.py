@@ -65,6 +65,17 @@ class SolveOptions:
     extra: dict[str, Any] = field(default_factory=dict)
     parsed: bool = False
 
+    @classmethod
+    def parsed_defaults(cls, relax: str | None, extra: dict[str, Any]) -> "SolveOptions":
+        """The common options at their defaults with back-end options ``extra``
+        already parsed: what :func:`assocopt.solve` builds for almost every call,
+        filled in without the dataclass ``__init__`` (the defaults need no check;
+        ``relax`` must be None or "lp", checked by the caller)."""
+        opts = object.__new__(cls)
+        opts.__dict__.update(relax=relax, time_limit=None, mip_gap=0.0, threads=None,
+                             verbose=False, extra=extra, parsed=True)
+        return opts
+
     def __post_init__(self) -> None:
         if self.relax not in (None, "lp"):
             raise InvalidProblemError(f"relax must be None or 'lp', got {self.relax!r}")
