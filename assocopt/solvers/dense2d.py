@@ -112,7 +112,8 @@ def assign_dense(C: np.ndarray, rm: np.ndarray, cm: np.ndarray, slack: bool = Fa
         cor = np.full(n1, -1, np.int64)
         cor[r] = c
         return cor, "plain"
-    cor = np.full(n1, -1, np.int64)
+    cor = np.empty(n1, np.int64)    # np.full's Python wrapper costs more at scan size
+    cor.fill(-1)
     rows_free, cols_free = flags if flags is not None else \
         (bool(np.isfinite(rm).all()), bool(np.isfinite(cm).all()))
     if cols_free and (not rows_free or n1 <= n2):
@@ -142,6 +143,9 @@ def _clipped(C: np.ndarray, a_miss: np.ndarray, b_miss: np.ndarray, cor: np.ndar
     r, c = _lap(R, method)
     if len(r) != n_a:
         raise LapInfeasibleError("not every index can be assigned")
+    if free is None and not transposed and n_a <= n_b and method == "scipy":
+        # r is 0..n_a-1 (every row assigned, scipy's order): one pass, no scatter
+        return np.where(R[r, c] < 0, c, -1), "reduced"
     if free is None:
         real = R[r, c] < 0
     else:
