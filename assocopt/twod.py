@@ -331,39 +331,53 @@ class Dense2D:
 
     def _check_small(self, cor: np.ndarray) -> Checked | str:
         """:meth:`check` on Python lists: for a scan's few rows the numpy calls of
-        :meth:`_check_bulk` cost more than the work (same answers, tested)."""
+        :meth:`_check_bulk` cost more than the work (same answers, tested).  One pass
+        splits the rows; the pairs are priced through the positions array (their flat
+        indices when every entry is finite), the misses from the miss lists."""
         n1, n2 = self.C.shape
-        lst = cor.tolist()
-        used = [False] * n2
-        pairs, miss_r = [], []
-        for i, j in enumerate(lst):
+        rows: list[int] = []
+        cols: list[int] = []
+        miss_r: list[int] = []
+        for i, j in enumerate(cor.tolist()):
             if j < 0:
                 miss_r.append(i)
-            elif j >= n2 or used[j]:
-                return "a column is assigned twice, or a column index is out of range"
             else:
-                used[j] = True
-                pairs.append((i, j))
-        miss_c = [j for j in range(n2) if not used[j]]
-        C, rm, cm = self.C, self.rm, self.cm
-        objective = math.fsum([C.item(i, j) for i, j in pairs] + [rm.item(i) for i in miss_r]
-                              + [cm.item(j) for j in miss_c])
+                rows.append(i)
+                cols.append(j)
+        taken = set(cols)
+        if cols and (max(cols) >= n2 or len(taken) != len(cols)):
+            return "a column is assigned twice, or a column index is out of range"
+        miss_c = [j for j in range(n2) if j not in taken]
+        k = len(rows)
+        r_idx, c_idx = self.miss_index
+        selected = None
+        if self.all_finite and len(r_idx) == n1 and len(c_idx) == n2:
+            base_r = self.n_pairs
+            base_c = base_r + n1
+            selected = np.array([i * n2 + j for i, j in zip(rows, cols)]
+                                + [base_r + i for i in miss_r]
+                                + [base_c + j for j in miss_c], np.int64)
+            flat = selected[:k]
+        else:
+            flat = np.array([i * n2 + j for i, j in zip(rows, cols)], np.int64)
+        rl, cl = self.rm.tolist(), self.cm.tolist()
+        objective = math.fsum(self.C.take(flat).tolist() + [rl[i] for i in miss_r]
+                              + [cl[j] for j in miss_c])
         if not math.isfinite(objective):
             return self._why_infinite(*(np.array(v, np.int64) for v in (
-                [i for i, _ in pairs], [j for _, j in pairs], miss_r, miss_c)))
-        r_idx, c_idx = self.miss_index
-        if self.all_finite and len(r_idx) == n1 and len(c_idx) == n2:
-            base_c = self.n_pairs + n1
-            pos = [i * n2 + j for i, j in pairs] + [self.n_pairs + i for i in miss_r] + \
-                [base_c + j for j in miss_c]
-            selected = np.array(pos, np.int64)
-        else:
+                rows, cols, miss_r, miss_c)))
+        if selected is None:
             selected = self.positions(*(np.array(v, np.int64) for v in (
-                [i for i, _ in pairs], [j for _, j in pairs], miss_r, miss_c)))
-        rows = [(i + 1, j + 1) for i, j in pairs]
-        if not self.slack:
-            rows += [(i + 1, 0) for i in miss_r] + [(0, j + 1) for j in miss_c]
-        tuples = np.array(rows, np.int64).reshape(-1, 2)
+                rows, cols, miss_r, miss_c)))
+        if self.slack:                 # the free surplus is never reported
+            first, second = rows, cols
+        else:                          # misses reported as (i, 0) and (0, j)
+            first = rows + miss_r + [-1] * len(miss_c)
+            second = cols + [-1] * len(miss_r) + miss_c
+        tuples = np.empty((len(first), 2), np.int64)
+        tuples[:, 0] = first
+        tuples[:, 1] = second
+        tuples += 1
         return Checked(selected, objective, tuples)
 
     def _why_infinite(self, rows: np.ndarray, cols: np.ndarray, miss_r: np.ndarray,

@@ -85,3 +85,22 @@ def test_huge_costs_are_still_scaled():
     C = np.array([[4.0, 1.0], [2.0, 3.0]]) * 1e200
     sol = solve(AssignmentProblem.dense(C))
     assert sol.objective == 3e200 and "cost_scale" in sol.info
+
+
+@pytest.mark.parametrize("seed", range(40))
+def test_small_and_bulk_checks_agree_on_rectangular_dense(seed):
+    """The list-based check and the numpy one agree on ``dense`` problems too (the
+    surplus of the larger side is free slack, never reported), forbidden entries and
+    infeasible answers included."""
+    rng = np.random.default_rng(seed)
+    n1, n2 = rng.integers(1, 7, size=2)
+    C = rng.random((n1, n2))
+    C[rng.random(C.shape) < 0.2] = np.inf
+    d = AssignmentProblem.dense(C).dense_view
+    for _ in range(10):
+        cor = rng.integers(-1, n2 + 1, size=n1)
+        a, b = d._check_small(cor), d._check_bulk(cor)
+        assert isinstance(a, str) == isinstance(b, str)
+        if not isinstance(a, str):
+            assert np.array_equal(a.selected, b.selected)
+            assert np.array_equal(a.tuples, b.tuples) and a.objective == b.objective
