@@ -207,7 +207,8 @@ def render(data: dict) -> str:
              "solve, the re-check of the answer, the `Solution`) against "
              "`linear_sum_assignment(C)`; *miss*: every row and column may stay "
              f"unassigned at {MISS} (costs uniform on [0, 1)), "
-             "`solve(AssignmentProblem.two_d(C, 0.3, 0.3))` against scipy on the "
+             "`solve(AssignmentProblem.two_d(C, rm, cm))` with `rm`, `cm` "
+             f"arrays of {MISS} against scipy on the "
              "`(n1 + n2) x (n2 + n1)` augmented matrix built beforehand.  "
              "*ratio* = assocopt / scipy; *lapjv* = `solve(..., solver=\"lapjv\")`.", ""]
     has_lapx = any("lapjv" in r["times_s"] for r in data["dense"])
