@@ -15,7 +15,7 @@ from .solution import Solution, Status
 from .solvers.base import (Backend, RawResult, SolveOptions, check_capabilities,
                            empty_answer, get_backend, module_installed)
 from .solvers.kernels import spent
-from .twod import _finite_amax
+from .twod_tables import _finite_amax
 
 __all__ = ["solve", "choose_solver", "BNB_MAX_CANDIDATES"]
 

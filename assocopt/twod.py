@@ -29,6 +29,7 @@ import numpy as np
 from .errors import InvalidProblemError
 from .validation import MAX_ABS_COST
 from .values import _as_matrix
+from .twod_tables import _finite_amax, _index_set, _pair_base, _row_offsets
 
 __all__ = ["Dense2D", "Checked", "LazyView", "from_matrix", "miss_vector",
            "MAX_DENSE_CANDIDATES"]
@@ -129,19 +130,6 @@ def _finite_index(a: np.ndarray) -> np.ndarray:
     if math.isfinite(a.sum()):
         return _arange(len(a))
     return np.isfinite(a).nonzero()[0]
-
-
-def _finite_amax(a: np.ndarray) -> float:
-    """Largest finite ``|a|`` (0 when there is none)."""
-    if a.size == 0:
-        return 0.0
-    hi, lo = float(a.max()), float(a.min())
-    if not (math.isfinite(hi) and math.isfinite(lo)):
-        a = a[np.isfinite(a)]
-        if a.size == 0:
-            return 0.0
-        hi, lo = float(a.max()), float(a.min())
-    return max(hi, -lo, 0.0)
 
 
 class Checked(NamedTuple):
@@ -403,27 +391,3 @@ class Dense2D:
         tuples = _pair_base(n).copy()       # rows 1..n in column 0, 1 in column 1
         tuples[:, 1] += cor
         return Checked(selected, objective, tuples)
-
-
-@functools.lru_cache(maxsize=256)
-def _index_set(n: int) -> frozenset[int]:
-    """``{0, ..., n-1}``: the values of a permutation of ``n`` items."""
-    return frozenset(range(n))
-
-
-@functools.lru_cache(maxsize=256)
-def _row_offsets(n1: int, n2: int) -> np.ndarray:
-    """``i * n2`` for each row ``i``: flat row-major index of row ``i``'s first entry."""
-    a = np.arange(n1, dtype=np.int64) * n2
-    a.setflags(write=False)
-    return a
-
-
-@functools.lru_cache(maxsize=256)
-def _pair_base(n: int) -> np.ndarray:
-    """``[[1, 1], [2, 1], ..., [n, 1]]``: the reported pairs of rows ``1..n`` before
-    their 0-based columns are added to column 1 (copied, never written)."""
-    a = np.ones((n, 2), np.int64)
-    a[:, 0] = np.arange(1, n + 1)
-    a.setflags(write=False)
-    return a
