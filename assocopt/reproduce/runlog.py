@@ -61,3 +61,44 @@ def trial_seconds(out: Path, names: Sequence[str]) -> dict[str, dict[str, float]
             con.close()
         res[name] = {"trials": int(n or 0), "seconds": float(s or 0.0)}
     return res
+
+
+def duration(seconds: float) -> str:
+    """Seconds as the pages print them: ``"42 s"``, or ``"3.5 min (210 s)"`` from 2 min."""
+    return f"{seconds:.0f} s" if seconds < 120 else f"{seconds / 60:.1f} min ({seconds:.0f} s)"
+
+
+def command(entry: Mapping[str, Any], paper: str) -> str:
+    """The command of one ``timing_history`` entry (the CLI form when it has no options)."""
+    if entry.get("options"):
+        return (f"`reproduce({paper!r}, runs={entry['runs']}, workers={entry['workers']}, "
+                f"seed={entry['seed']}, options={entry['options']!r})`")
+    return (f"`assocopt reproduce {paper} --runs {entry['runs']} --workers {entry['workers']} "
+            f"--seed {entry['seed']}`")
+
+
+def timing_lines(summary: Mapping[str, Any], paper: str, heading: list[str]) -> list[str]:
+    """The page's timing table: wall time of each invocation that ran trials, and the
+    compute time stored with the trials (which also counts interrupted invocations).
+    ``heading`` is the section's first lines; nothing when no invocation is recorded."""
+    hist = summary.get("timing_history", [])
+    if not hist:
+        return []
+    L = list(heading)
+    L += ["| invocation | command | experiment | trials run | wall time |", "|---|---|---|---|---|"]
+    for i, h in enumerate(hist, start=1):
+        cmd = command(h, paper)
+        done = [(name, t) for name, t in h["experiments"].items() if t["done"]]
+        for name, t in done:
+            L.append(f"| {i} | {cmd} | {name} | {t['done']} | {duration(t['wall_s'])} |")
+        tot = sum(t["wall_s"] for _, t in done)
+        L.append(f"| {i} | {cmd} | **all** | {sum(t['done'] for _, t in done)} | "
+                 f"**{duration(tot)}** |")
+    ts = summary.get("trial_seconds", {})
+    if ts:
+        L += ["", "Compute time stored with the trials (sum over the trials of the seconds "
+              "each took in its worker process; 2 workers share the wall time):", "",
+              "| experiment | trials stored | compute time |", "|---|---|---|"]
+        for name, t in ts.items():
+            L.append(f"| {name} | {t['trials']} | {duration(t['seconds'])} |")
+    return L + [""]

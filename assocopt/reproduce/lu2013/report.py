@@ -14,6 +14,8 @@ from typing import Any, Iterable, Mapping, Sequence
 
 import numpy as np
 
+from ..runlog import command, timing_lines  # noqa: F401  (command: re-exported)
+
 __all__ = ["render_tables", "index_records", "GEOMETRY_LABELS", "command"]
 
 SIGMAS = (1.5, 5.0)
@@ -294,46 +296,6 @@ def _printed_kld(summary) -> list[str]:
     return L + [""]
 
 
-def _timing(summary) -> list[str]:
-    """Wall time of each invocation that ran trials, and the compute time stored with
-    the trials (which also counts invocations that were interrupted)."""
-    hist = summary.get("timing_history", [])
-    if not hist:
-        return []
-    L = _section("timing", "Runs that computed trials (wall time of each invocation)")
-    L += ["| invocation | command | experiment | trials run | wall time |", "|---|---|---|---|---|"]
-    for i, h in enumerate(hist, start=1):
-        cmd = command(h, "lu2013")
-        for name, t in h["experiments"].items():
-            if t["done"]:
-                L.append(f"| {i} | {cmd} | {name} | {t['done']} | {_duration(t['wall_s'])} |")
-        done = [t for t in h["experiments"].values() if t["done"]]
-        tot = sum(t["wall_s"] for t in done)
-        L.append(f"| {i} | {cmd} | **all** | {sum(t['done'] for t in done)} | "
-                 f"**{_duration(tot)}** |")
-    ts = summary.get("trial_seconds", {})
-    if ts:
-        L += ["", "Compute time stored with the trials (sum over the trials of the seconds "
-              "each took in its worker process; 2 workers share the wall time):", "",
-              "| experiment | trials stored | compute time |", "|---|---|---|"]
-        for name, t in ts.items():
-            L.append(f"| {name} | {t['trials']} | {_duration(t['seconds'])} |")
-    return L + [""]
-
-
-def command(entry: Mapping[str, Any], paper: str) -> str:
-    """The command of one ``timing_history`` entry (the CLI form when it has no options)."""
-    if entry.get("options"):
-        return (f"`reproduce({paper!r}, runs={entry['runs']}, workers={entry['workers']}, "
-                f"seed={entry['seed']}, options={entry['options']!r})`")
-    return (f"`assocopt reproduce {paper} --runs {entry['runs']} --workers {entry['workers']} "
-            f"--seed {entry['seed']}`")
-
-
-def _duration(seconds: float) -> str:
-    return f"{seconds:.0f} s" if seconds < 120 else f"{seconds / 60:.1f} min ({seconds:.0f} s)"
-
-
 def render_tables(summary: Mapping[str, Any]) -> str:
     """Markdown of every table of the reproduction (sections marked for the page)."""
     ix = index_records(summary["records"])
@@ -349,5 +311,6 @@ def render_tables(summary: Mapping[str, Any]) -> str:
     L += _fig2_gains(summary, ix)
     L += _region(summary, ix)
     L += _printed_kld(summary)
-    L += _timing(summary)
+    L += timing_lines(summary, "lu2013", _section(
+        "timing", "Runs that computed trials (wall time of each invocation)"))
     return "\n".join(L)

@@ -14,6 +14,8 @@ from typing import Any, Mapping
 
 import numpy as np
 
+from ..runlog import command, timing_lines  # noqa: F401  (command: re-exported)
+
 __all__ = ["render_tables", "make_figures", "expected_matchings"]
 
 MAIN_METHODS = ("tbm+nd", "ncr+nd", "ncr+2da", "ncr+2da-rect")
@@ -234,50 +236,6 @@ def _same_condition(summary) -> list[str]:
     return L + [""]
 
 
-def _duration(seconds: float) -> str:
-    return f"{seconds:.0f} s" if seconds < 120 else f"{seconds / 60:.1f} min ({seconds:.0f} s)"
-
-
-def _timing(summary) -> list[str]:
-    """Wall time of each invocation that ran trials, and the compute time stored with
-    the trials (which also counts invocations that were interrupted)."""
-    hist = summary.get("timing_history", [])
-    if not hist:
-        return []
-    L = _section("timing", "Runs that computed trials (wall time of each invocation)")
-    L += ["| invocation | command | experiment | trials run | wall time |", "|---|---|---|---|---|"]
-    for i, h in enumerate(hist, start=1):
-        cmd = command(h, "zhang2009")
-        for name, t in h["experiments"].items():
-            if t["done"]:
-                w = t["wall_s"]
-                L.append(f"| {i} | {cmd} | {name} | {t['done']} | "
-                         f"{f'{w:.0f} s' if w < 120 else f'{w / 60:.1f} min ({w:.0f} s)'} |")
-        done = [t for t in h["experiments"].values() if t["done"]]
-        tot = sum(t["wall_s"] for t in done)
-        L.append(f"| {i} | {cmd} | **all** | {sum(t['done'] for t in done)} | "
-                 f"**{_duration(tot)}** |")
-    ts = summary.get("trial_seconds", {})
-    if ts:
-        L += ["", "Compute time stored with the trials (sum over the trials of the seconds "
-              "each took in its worker process; 2 workers share the wall time):", "",
-              "| experiment | trials stored | compute time |", "|---|---|---|"]
-        for name, t in ts.items():
-            w = t["seconds"]
-            L.append(f"| {name} | {t['trials']} | "
-                     f"{f'{w:.0f} s' if w < 120 else f'{w / 60:.1f} min ({w:.0f} s)'} |")
-    return L + [""]
-
-
-def command(entry: Mapping[str, Any], paper: str) -> str:
-    """The command of one ``timing_history`` entry (the CLI form when it has no options)."""
-    if entry.get("options"):
-        return (f"`reproduce({paper!r}, runs={entry['runs']}, workers={entry['workers']}, "
-                f"seed={entry['seed']}, options={entry['options']!r})`")
-    return (f"`assocopt reproduce {paper} --runs {entry['runs']} --workers {entry['workers']} "
-            f"--seed {entry['seed']}`")
-
-
 def render_tables(summary: Mapping[str, Any]) -> str:
     """Markdown tables (named sections), the paper's Table 1 beside ours."""
     L: list[str] = []
@@ -303,7 +261,8 @@ def render_tables(summary: Mapping[str, Any]) -> str:
                           "correct_rate", "f", "Ours — sensitivity of MD-2DA to alpha (tau) "
                           "and of MD-ND to its readings (P_d fixed)")
     L += _paired_table(summary)
-    L += _timing(summary)
+    L += timing_lines(summary, "zhang2009", _section(
+        "timing", "Runs that computed trials (wall time of each invocation)"))
     return "\n".join(L)
 
 
