@@ -1,8 +1,11 @@
-"""Shared fixtures: the back ends under test, the public benchmark folder, and the
-small random S-D problems the Lagrangian and branch-and-bound tests draw."""
+"""Shared fixtures: the back ends under test, the public benchmark folder, the
+small random S-D problems the Lagrangian and branch-and-bound tests draw, and the
+check that a paper page's generated blocks match its committed summary."""
 
 from __future__ import annotations
 
+import json
+import re
 from pathlib import Path
 
 import pytest
@@ -63,3 +66,26 @@ def sd_problems(draw, dummies=None):
     else:
         shape = (draw(st.integers(1, {3: 4, 4: 3, 5: 2}[N])),) * N
     return AssignmentProblem.dense(draw_costs(draw, shape, integer))
+
+
+def page_block(text: str, name: str) -> str:
+    """The generated block ``name`` of a docs page (between its begin/end markers)."""
+    m = re.search(rf"<!-- {name}:begin -->\n(.*?)\n<!-- {name}:end -->", text, re.DOTALL)
+    assert m, f"the page has no generated block {name!r}"
+    return m.group(1).strip()
+
+
+def check_page_against_summary(repro, paper: str, page: Path, summary_path: Path) -> dict:
+    """Assert a paper page's tables, parameters and headline blocks are what ``repro``
+    renders from the committed summary, that the summary was run with the current
+    default parameters, and that every figure it lists is committed and shown on the
+    page; returns the summary for paper-specific checks."""
+    summary = json.loads(summary_path.read_text())
+    text = page.read_text(encoding="utf-8")
+    assert page_block(text, "tables") == repro.render_tables(summary).strip()
+    assert page_block(text, "parameters") == repro.render_parameters(summary).strip()
+    assert page_block(text, "headline") == repro.render_headline(summary).strip()
+    assert summary["parameters"] == json.loads(json.dumps(repro.parameters()))
+    for f in summary["figures"]:
+        assert (summary_path.parent / f).is_file() and f"{paper}/{f}" in text
+    return summary

@@ -4,10 +4,11 @@ options are checked, and the page shows exactly what the committed summary gives
 from __future__ import annotations
 
 import json
-import re
 from pathlib import Path
 
 import pytest
+
+from conftest import check_page_against_summary
 
 ROOT = Path(__file__).resolve().parents[1]
 SMALL = {"n_targets": 10, "missed": 2, "false_tracks": 2, "n_steps": 3,
@@ -55,21 +56,8 @@ PAGE = ROOT / "docs" / "papers" / "dong2015.md"
 SUMMARY = ROOT / "docs" / "papers" / "dong2015" / "summary.json"
 
 
-def _block(text: str, name: str) -> str:
-    m = re.search(rf"<!-- {name}:begin -->\n(.*?)\n<!-- {name}:end -->", text, re.DOTALL)
-    assert m, f"the page has no generated block {name!r}"
-    return m.group(1).strip()
-
-
 def test_page_tables_match_the_committed_summary():
     from assocopt.reproduce import dong2015 as repro
-    summary = json.loads(SUMMARY.read_text())
-    text = PAGE.read_text(encoding="utf-8")
-    assert _block(text, "tables") == repro.render_tables(summary).strip()
-    assert _block(text, "parameters") == repro.render_parameters(summary).strip()
-    assert _block(text, "headline") == repro.render_headline(summary).strip()
-    assert summary["parameters"] == json.loads(json.dumps(repro.parameters()))
+    summary = check_page_against_summary(repro, "dong2015", PAGE, SUMMARY)
     assert summary["runs"] == 50 and summary["seed"] == 0
     assert all(r["agree"] for r in summary["lap_paths"] if "agree" in r)
-    for f in summary["figures"]:
-        assert (SUMMARY.parent / f).is_file() and f"dong2015/{f}" in text

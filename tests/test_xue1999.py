@@ -6,7 +6,6 @@ from __future__ import annotations
 
 import json
 import math
-import re
 from pathlib import Path
 
 import numpy as np
@@ -20,6 +19,7 @@ from assocopt.tracking.decide.nearest import gnn_assign, nearest_neighbour
 from assocopt.tracking.scenarios.xue1999 import Xue1999
 from assocopt.tracking.scenarios.xue1999_tracker import (METHODS, association_costs,
                                                          run_metrics, run_tracker)
+from conftest import check_page_against_summary
 
 ROOT = Path(__file__).resolve().parents[1]
 
@@ -366,20 +366,7 @@ PAGE = ROOT / "docs" / "papers" / "xue1999.md"
 SUMMARY = ROOT / "docs" / "papers" / "xue1999" / "summary.json"
 
 
-def _block(text: str, name: str) -> str:
-    m = re.search(rf"<!-- {name}:begin -->\n(.*?)\n<!-- {name}:end -->", text, re.DOTALL)
-    assert m, f"the page has no generated block {name!r}"
-    return m.group(1).strip()
-
-
 def test_page_tables_match_the_committed_summary():
     from assocopt.reproduce import xue1999 as repro
-    summary = json.loads(SUMMARY.read_text())
-    text = PAGE.read_text(encoding="utf-8")
-    assert _block(text, "tables") == repro.render_tables(summary).strip()
-    assert _block(text, "parameters") == repro.render_parameters(summary).strip()
-    assert _block(text, "headline") == repro.render_headline(summary).strip()
-    assert summary["parameters"] == json.loads(json.dumps(repro.parameters()))  # current defaults
+    summary = check_page_against_summary(repro, "xue1999", PAGE, SUMMARY)
     assert summary["runs"] == 200 and summary["seed"] == 0
-    for f in summary["figures"]:
-        assert (SUMMARY.parent / f).is_file() and f"xue1999/{f}" in text
