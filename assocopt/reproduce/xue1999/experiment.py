@@ -1,19 +1,5 @@
-"""Paper 003's experiments: the options, the trial and the Experiment grid.
-
-The paper shows four crossing targets (Figs. 2-3) and claims correct associations
-despite many crossings and strong noise; it gives no parameter and no number.  Two
-experiments, each with its own store ``OUT/xue1999-*.sqlite``:
-
-``main``   the base scene (noise scale 1, clutter mean ``clutter_mean``): every method
-           of :data:`~assocopt.tracking.scenarios.xue1999_tracker.METHODS`, per-scan
-           correct association rate, track swaps, false tracks, targets held at the
-           end, and DID's stage-2 and non-convergence rates.
-``sweep``  noise scale x clutter mean grid (``noise_grid`` x ``clutter_grid``) with
-           ``sweep_methods``, ``runs // sweep_divisor`` runs per point.
-
-Every method of a trial tracks the same simulated run (paired comparison).  All
-parameters are ours and recorded in ``summary.json``; the page is
-``docs/papers/xue1999.md``.
+"""Paper 003's experiments: the options, the trial and the Experiment grid (the two
+experiments, ``main`` and ``sweep``, are described in :mod:`assocopt.reproduce.xue1999`).
 """
 
 from __future__ import annotations
