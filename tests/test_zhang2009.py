@@ -227,6 +227,11 @@ def test_reproduction_writes_summary_tables_and_resumes(tmp_path):
         assert (tmp_path / f).stat().st_size > 0
     again = repro.run(2, 1, 3, tmp_path, echo=lambda t: None)
     assert all(v["done"] == 0 for v in again["timing"].values())
+    # the resumed run computed nothing: the history keeps the first invocation only
+    assert [h["runs"] for h in again["timing_history"]] == [2]
+    assert again["timing_history"][0]["experiments"] == s["timing"]
+    stored = again["trial_seconds"]
+    assert set(stored) == set(s["timing"]) and all(t["trials"] > 0 for t in stored.values())
     stable = lambda recs: sorted((json.dumps(r["setting"], sort_keys=True), r["method"],
                                   r["metric"], r["value"]) for r in recs if not r["volatile"])
     assert stable(again["records"]) == stable(s["records"])

@@ -12,7 +12,22 @@ import sqlite3
 from pathlib import Path
 from typing import Any, Mapping, Sequence
 
-__all__ = ["timing_history", "trial_seconds"]
+from ..experiments import run_all
+
+__all__ = ["run_timed", "timing_history", "trial_seconds"]
+
+
+def run_timed(exps: Sequence[Any], out: Path, *, runs: int, workers: int, seed: int,
+              options: Mapping[str, Any] | None = None, executor: Any = None,
+              progress: bool = False) -> dict[str, Any]:
+    """Run (or resume) ``exps`` into ``out`` and return the summary's three timing
+    entries, in the order the summaries store them: ``timing`` (this invocation),
+    ``timing_history`` (:func:`timing_history`) and ``trial_seconds``."""
+    timing = run_all(exps, out, workers=workers, executor=executor, progress=progress)
+    history = timing_history(Path(out) / "summary.json", timing, runs=runs,
+                             workers=workers, seed=seed, options=options)
+    return {"timing": timing, "timing_history": history,
+            "trial_seconds": trial_seconds(out, [e.name for e in exps])}
 
 
 def timing_history(previous_summary: Path, timing: Mapping[str, Mapping[str, Any]], *,

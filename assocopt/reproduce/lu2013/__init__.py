@@ -33,7 +33,7 @@ from typing import Any, Mapping, Sequence
 
 from ...tracking.costs.sd_builder import COSTS
 from .._report import write_report
-from ..runlog import timing_history, trial_seconds
+from ..runlog import run_timed
 from .divergence import printed_kld_summary
 from .experiment import (D_GRID, DEFAULTS, DISAGREEMENT_PAIRS, METHODS,  # noqa: F401
                          OURS_PARAMS, PAPER_FIG2_GAIN, PAPER_LABELS, PAPER_TABLES, PRINTED,
@@ -61,14 +61,13 @@ def run(runs: int, workers: int, seed: int, out, *, progress: bool = False,
     """
     from pathlib import Path
 
-    from ...experiments import paired_differences, report_records, run_all, summarise
+    from ...experiments import paired_differences, report_records, summarise
     from ...io.writers import jsonable
 
     out = Path(out)
     exps = experiments(runs, seed, options, parts)
-    timing = run_all(exps, out, workers=workers, executor=executor, progress=progress)
-    history = timing_history(out / "summary.json", timing, runs=runs, workers=workers,
-                             seed=seed, options=options)
+    timed = run_timed(exps, out, runs=runs, workers=workers, seed=seed, options=options,
+                      executor=executor, progress=progress)
     records: list[dict[str, Any]] = []
     disagreements = []
     for exp in exps:
@@ -102,9 +101,7 @@ def run(runs: int, workers: int, seed: int, out, *, progress: bool = False,
         "derived": {"disagreements": disagreements,
                     "printed_kld": printed_kld_summary(
                         SIGMAS, region_km=_options(options)["region_km"])},
-        "timing": timing,
-        "timing_history": history,
-        "trial_seconds": trial_seconds(out, [e.name for e in exps]),
+        **timed,
     }
     summary = jsonable(summary, nonfinite="null")        # as summary.json stores it
     return write_report(out, summary, render_tables, make_figures, echo)

@@ -27,10 +27,10 @@ from __future__ import annotations
 from pathlib import Path
 from typing import Any, Mapping, Sequence
 
-from ...experiments import report_records, run_all, summarise
+from ...experiments import report_records, summarise
 from ...io.writers import jsonable
 from .._report import write_report
-from ..runlog import timing_history, trial_seconds
+from ..runlog import run_timed
 from .experiment import (DEFAULTS, LABELS, MAIN_METHODS, METHODS, PAIRS,  # noqa: F401
                          PAPER_CLAIMS, PAPER_METHODS, PAPER_TABLE1, R, TABLE1_METHODS,
                          TABLE1_PD, VOLATILE, W, _measure_params, _options, experiments,
@@ -54,9 +54,8 @@ def run(runs: int, workers: int, seed: int, out, *, progress: bool = False,
     """
     out = Path(out)
     exps = experiments(runs, seed, options, parts)
-    timing = run_all(exps, out, workers=workers, executor=executor, progress=progress)
-    history = timing_history(out / "summary.json", timing, runs=runs, workers=workers,
-                             seed=seed, options=options)
+    timed = run_timed(exps, out, runs=runs, workers=workers, seed=seed, options=options,
+                      executor=executor, progress=progress)
     records: list[dict[str, Any]] = []
     for exp in exps:
         rows = summarise(out / f"{exp.name}.sqlite", exp, include_volatile=True)
@@ -79,9 +78,7 @@ def run(runs: int, workers: int, seed: int, out, *, progress: bool = False,
                          "table1_p_d": list(TABLE1_PD), "claims": PAPER_CLAIMS},
         "records": records,
         "paired": paired,
-        "timing": timing,
-        "timing_history": history,
-        "trial_seconds": trial_seconds(out, [e.name for e in exps]),
+        **timed,
     }
     summary = jsonable(summary, nonfinite="null")        # as summary.json stores it
     return write_report(out, summary, render_tables, make_figures, echo)
