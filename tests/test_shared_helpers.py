@@ -96,3 +96,44 @@ def test_no_other_atomic_writer_json_sanitiser_or_progress_bar():
                 if needle in text:
                     bad.append(f"{f.relative_to(ROOT)}: {needle}")
     assert not bad, "\n".join(bad)
+
+
+@pytest.mark.parametrize("paper", ["dong2015", "lu2013", "xue1999", "yan2010", "zhang2009"])
+def test_reproduction_figures_without_matplotlib_are_none(paper, tmp_path, monkeypatch):
+    import importlib
+    from assocopt.reproduce._plot import pyplot
+    repro = importlib.import_module(f"assocopt.reproduce.{paper}")
+    summary = json.loads((ROOT / "docs" / "papers" / paper / "summary.json").read_text())
+    monkeypatch.setitem(sys.modules, "matplotlib", None)
+    monkeypatch.setitem(sys.modules, "matplotlib.pyplot", None)
+    assert pyplot() is None
+    extra = (repro.experiment._options(None),) if paper == "xue1999" else ()
+    assert repro.make_figures(summary, tmp_path, *extra) == []
+    assert list(tmp_path.iterdir()) == []
+
+
+def test_plot_save_writes_closes_and_names_the_figure(tmp_path):
+    from assocopt.reproduce._plot import draw_all, pyplot, save
+    plt = pyplot()
+    if plt is None:
+        pytest.skip("matplotlib not installed")
+
+    def one(plt, summary, out, title):
+        fig, ax = plt.subplots()
+        ax.set_title(title)
+        return save(fig, out, "one.png", rect=(0, 0, 1, 0.9))
+
+    before = set(plt.get_fignums())
+    assert draw_all({}, tmp_path, (one, lambda *a: None), "t") == ["one.png"]
+    assert (tmp_path / "one.png").read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+    assert set(plt.get_fignums()) == before
+
+
+def test_no_other_figure_writer_in_the_reproductions():
+    """The reproductions draw through reproduce/_plot.py (one back end, one resolution)."""
+    own = ROOT / "assocopt" / "reproduce" / "_plot.py"
+    bad = [f"{f.relative_to(ROOT)}: {needle}"
+           for f in sorted((ROOT / "assocopt" / "reproduce").rglob("*.py")) if f != own
+           for needle in ("matplotlib.use(", ".savefig(", "plt.close(")
+           if needle in f.read_text(encoding="utf-8")]
+    assert not bad, "\n".join(bad)

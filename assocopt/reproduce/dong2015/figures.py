@@ -4,11 +4,11 @@ growth of the time per step; 95 % bands everywhere."""
 
 from __future__ import annotations
 
-from pathlib import Path
 from typing import Any, Mapping
 
 import numpy as np
 
+from .._plot import draw_all, save
 from .experiment import LABELS
 from .report import lookup, steps_of
 
@@ -20,19 +20,7 @@ FIG_METHODS = ("tsd", "ted", "tsd-obj", "ted-obj", "tsd-c", "tsd-c-global", "gnn
 
 def make_figures(summary: Mapping[str, Any], out) -> list[str]:
     """Write the PNG figures into ``out``; [] without matplotlib."""
-    try:
-        import matplotlib
-        matplotlib.use("Agg")
-        import matplotlib.pyplot as plt
-    except ImportError:
-        return []
-    out = Path(out)
-    made = []
-    for fn in (_per_env, _heading, _coef, _timing):
-        name = fn(plt, summary, out)
-        if name:
-            made.append(name)
-    return made
+    return draw_all(summary, out, (_per_env, _heading, _coef, _timing))
 
 
 def _curve(recs, part, prefix, method, env, coef=None):
@@ -68,10 +56,7 @@ def _per_env(plt, summary, out) -> str | None:
         ax.grid(alpha=0.3)
     axes[0].set_ylabel("correct association rate E_c")
     axes[-1].legend(fontsize=7, loc="lower right")
-    fig.tight_layout()
-    fig.savefig(out / "fig_ec_per_step.png", dpi=110)
-    plt.close(fig)
-    return "fig_ec_per_step.png"
+    return save(fig, out, "fig_ec_per_step.png")
 
 
 def _heading(plt, summary, out) -> str | None:
@@ -90,10 +75,7 @@ def _heading(plt, summary, out) -> str | None:
     ax.set_title("heading error, environment 2 (paper's Fig. 2)")
     ax.legend(fontsize=8)
     ax.grid(alpha=0.3)
-    fig.tight_layout()
-    fig.savefig(out / "fig_heading.png", dpi=110)
-    plt.close(fig)
-    return "fig_heading.png"
+    return save(fig, out, "fig_heading.png")
 
 
 def _coef(plt, summary, out) -> str | None:
@@ -115,10 +97,7 @@ def _coef(plt, summary, out) -> str | None:
     np.atleast_1d(axes)[0].set_ylabel("E_c (environment 2)")
     np.atleast_1d(axes)[-1].legend(fontsize=7)
     fig.suptitle("threshold coefficient of our T_1 substitute (paper's Figs. 3-4)", fontsize=10)
-    fig.tight_layout()
-    fig.savefig(out / "fig_coef.png", dpi=110)
-    plt.close(fig)
-    return "fig_coef.png"
+    return save(fig, out, "fig_coef.png")
 
 
 def _timing(plt, summary, out) -> str | None:
@@ -139,7 +118,4 @@ def _timing(plt, summary, out) -> str | None:
     ax.set_ylabel("time per step (ms)")
     ax.legend(fontsize=8)
     ax.grid(alpha=0.3, which="both")
-    fig.tight_layout()
-    fig.savefig(out / "fig_timing.png", dpi=110)
-    plt.close(fig)
-    return "fig_timing.png"
+    return save(fig, out, "fig_timing.png")

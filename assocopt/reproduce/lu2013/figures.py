@@ -6,6 +6,7 @@ from typing import Any, Mapping, Sequence
 
 import numpy as np
 
+from .._plot import pyplot, save
 from .report import D_GRID, REFERENCE, SIGMAS, _methods, index_records
 
 __all__ = ["make_figures"]
@@ -14,11 +15,8 @@ __all__ = ["make_figures"]
 def make_figures(summary: Mapping[str, Any], out) -> list[str]:
     """Fig. 1 (r versus d), Fig. 2 (difference to ref. [2] with 95 % bands, and the
     rates themselves) as PNG; [] without matplotlib."""
-    try:
-        import matplotlib
-        matplotlib.use("Agg")
-        import matplotlib.pyplot as plt
-    except ImportError:
+    plt = pyplot()
+    if plt is None:
         return []
     from pathlib import Path
     out = Path(out)
@@ -57,10 +55,7 @@ def make_figures(summary: Mapping[str, Any], out) -> list[str]:
             ax.grid(alpha=0.3)
         _shared_legend(fig, axes)
         fig.suptitle(f"Fig. 1: solution discrimination r versus d (ours, {runs} runs per point)")
-        fig.tight_layout(rect=(0, 0.1, 1, 1))
-        fig.savefig(out / fname, dpi=110)
-        plt.close(fig)
-        made.append(fname)
+        made.append(save(fig, out, fname, rect=(0, 0.1, 1, 1)))
 
     # Fig. 2, differences to the reference (the comparison the paper is about): one row
     # for the paper's costs as printed (and the reversed KL, which decides like them),
@@ -91,10 +86,7 @@ def make_figures(summary: Mapping[str, Any], out) -> list[str]:
             ax.legend(fontsize=7, loc="lower right", ncol=2)
     fig.suptitle(f"Fig. 2: each cost's correct association rate minus ref. [2]'s, paired, "
                  f"95 % bands (ours, {runs} runs per point)")
-    fig.tight_layout()
-    fig.savefig(out / "fig2_difference.png", dpi=110)
-    plt.close(fig)
-    made.append("fig2_difference.png")
+    made.append(save(fig, out, "fig2_difference.png"))
 
     # Fig. 2, the rates themselves (ref. [2] with its band; the others are within it)
     fig, axes = plt.subplots(1, 2, figsize=(11, 4.4), sharex=True)
@@ -111,10 +103,7 @@ def make_figures(summary: Mapping[str, Any], out) -> list[str]:
         ax.grid(alpha=0.3)
     _shared_legend(fig, axes)
     fig.suptitle(f"Fig. 2: correct association rate versus d (ours, {runs} runs per point)")
-    fig.tight_layout(rect=(0, 0.1, 1, 1))
-    fig.savefig(out / "fig2_correct.png", dpi=110)
-    plt.close(fig)
-    made.append("fig2_correct.png")
+    made.append(save(fig, out, "fig2_correct.png", rect=(0, 0.1, 1, 1)))
     return made
 
 

@@ -3,12 +3,12 @@ per-scan correct association rate with 95 % bands, and the noise x clutter sweep
 
 from __future__ import annotations
 
-from pathlib import Path
 from typing import Any, Mapping
 
 import numpy as np
 
 from ...tracking.scenarios.xue1999_tracker import METHODS, run_tracker
+from .._plot import draw_all, save
 from . import experiment as exp
 from .experiment import LABELS
 from .report import lookup
@@ -23,19 +23,7 @@ _METHOD_COLOURS = {"did": "tab:blue", "did-literal": "tab:orange", "did-origin":
 
 def make_figures(summary: Mapping[str, Any], out, options: Mapping[str, Any]) -> list[str]:
     """Write the PNG figures into ``out``; [] without matplotlib."""
-    try:
-        import matplotlib
-        matplotlib.use("Agg")
-        import matplotlib.pyplot as plt
-    except ImportError:
-        return []
-    out = Path(out)
-    made = []
-    for fn in (_scene, _per_scan, _sweep):
-        name = fn(plt, summary, out, options)
-        if name:
-            made.append(name)
-    return made
+    return draw_all(summary, out, (_scene, _per_scan, _sweep), options)
 
 
 def _scene(plt, summary, out, o) -> str | None:
@@ -82,10 +70,7 @@ def _scene(plt, summary, out, o) -> str | None:
     fig.suptitle(f"one run (seed {o['example_seed']}), noise scale {sc.noise_scale:g}, "
                  f"clutter mean {sc.clutter_mean:g} per scan (ours); track colour = the "
                  "target whose report started it, black = started by clutter", fontsize=9)
-    fig.tight_layout(rect=(0, 0, 1, 0.93))
-    fig.savefig(out / "fig_scene.png", dpi=110, bbox_inches="tight")
-    plt.close(fig)
-    return "fig_scene.png"
+    return save(fig, out, "fig_scene.png", rect=(0, 0, 1, 0.93), bbox_inches="tight")
 
 
 def _per_scan(plt, summary, out, o) -> str | None:
@@ -112,10 +97,7 @@ def _per_scan(plt, summary, out, o) -> str | None:
     ax.set_ylim(0, 1.02)
     ax.grid(alpha=0.3)
     ax.legend(fontsize=7, loc="lower left")
-    fig.tight_layout()
-    fig.savefig(out / "fig_per_scan.png", dpi=110)
-    plt.close(fig)
-    return "fig_per_scan.png"
+    return save(fig, out, "fig_per_scan.png")
 
 
 def _sweep(plt, summary, out, o) -> str | None:
@@ -140,7 +122,4 @@ def _sweep(plt, summary, out, o) -> str | None:
     axes[0].legend(fontsize=7)
     runs = max(v[1] for v in tab.values())
     fig.suptitle(f"where each method breaks ({runs} runs per point, 95 % CI)", fontsize=9)
-    fig.tight_layout(rect=(0, 0, 1, 0.93))
-    fig.savefig(out / "fig_sweep.png", dpi=110, bbox_inches="tight")
-    plt.close(fig)
-    return "fig_sweep.png"
+    return save(fig, out, "fig_sweep.png", rect=(0, 0, 1, 0.93), bbox_inches="tight")

@@ -7,6 +7,7 @@ from __future__ import annotations
 
 from typing import Any, Mapping
 
+from .._plot import pyplot, save
 from .experiment import (FIG4_METHODS, LABELS, PAPER_TABLE1, SENS_METHODS, SENS_VARIANTS,
                          TABLE1_METHODS, TABLE1_N)
 
@@ -140,11 +141,8 @@ def _three_node_table(recs) -> list[str]:
 def make_figures(summary: Mapping[str, Any], out) -> list[str]:
     """Fig. 4 (correct rate over time with 95 % bands) and Table 1 as a plot; [] without
     matplotlib."""
-    try:
-        import matplotlib
-        matplotlib.use("Agg")
-        import matplotlib.pyplot as plt
-    except ImportError:
+    plt = pyplot()
+    if plt is None:
         return []
     recs = summary["records"]
     made = []
@@ -172,10 +170,7 @@ def make_figures(summary: Mapping[str, Any], out) -> list[str]:
         ax.grid(alpha=0.3)
         ax.legend(fontsize=7, loc="lower left")
         ax.set_title("yan2010 Fig. 4: correct rate over time (95 % bands)")
-        fig.tight_layout()
-        fig.savefig(out / "fig4_correct_rate.png", dpi=110)
-        plt.close(fig)
-        made.append("fig4_correct_rate.png")
+        made.append(save(fig, out, "fig4_correct_rate.png"))
     c80 = lookup(recs, "table1", "correct_80")
     if c80:
         fig, ax = plt.subplots(figsize=(7, 4))
@@ -188,8 +183,5 @@ def make_figures(summary: Mapping[str, Any], out) -> list[str]:
         ax.set_ylabel("correct association probability at t = 80 s")
         ax.grid(alpha=0.3)
         ax.legend(fontsize=7)
-        fig.tight_layout()
-        fig.savefig(out / "table1_correct_rate.png", dpi=110)
-        plt.close(fig)
-        made.append("table1_correct_rate.png")
+        made.append(save(fig, out, "table1_correct_rate.png"))
     return made

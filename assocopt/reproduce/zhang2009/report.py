@@ -14,6 +14,7 @@ from typing import Any, Mapping
 
 import numpy as np
 
+from .._plot import pyplot, save
 from ..runlog import command, timing_lines  # noqa: F401  (command: re-exported)
 
 __all__ = ["render_tables", "make_figures", "expected_matchings"]
@@ -269,11 +270,8 @@ def render_tables(summary: Mapping[str, Any]) -> str:
 # ----------------------------------------------------------------- figures
 def make_figures(summary: Mapping[str, Any], out) -> list[str]:
     """Figs. 1-5, Table 1 and the sensitivity study as PNG; [] without matplotlib."""
-    try:
-        import matplotlib
-        matplotlib.use("Agg")
-        import matplotlib.pyplot as plt
-    except ImportError:
+    plt = pyplot()
+    if plt is None:
         return []
     out = Path(out)
     recs = summary["records"]
@@ -296,10 +294,7 @@ def make_figures(summary: Mapping[str, Any], out) -> list[str]:
         ax.set_title(f"{title}\n(ours, {runs} runs per point, 95% CI)", fontsize=10)
         ax.grid(alpha=0.3)
         ax.legend(fontsize=8)
-        fig.tight_layout()
-        fig.savefig(out / fname, dpi=110)
-        plt.close(fig)
-        made.append(fname)
+        made.append(save(fig, out, fname))
 
     curve("fig1_pc_vs_f_measures.png", "main", "f", ("tbm+nd", "ncr+nd"), "noise factor f",
           "Fig. 1: MM-TBM vs MM-NCR (truncation)")
@@ -338,8 +333,5 @@ def make_figures(summary: Mapping[str, Any], out) -> list[str]:
         ax.set_title("Table 1: decision time (paper's hardware not given)", fontsize=10)
         ax.grid(alpha=0.3, which="both")
         ax.legend(fontsize=7)
-        fig.tight_layout()
-        fig.savefig(out / "table1_time.png", dpi=110)
-        plt.close(fig)
-        made.append("table1_time.png")
+        made.append(save(fig, out, "table1_time.png"))
     return made
