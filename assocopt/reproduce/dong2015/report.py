@@ -5,6 +5,7 @@ from __future__ import annotations
 
 from typing import Any, Mapping
 
+from .._report import mean_ci, wall_time_line
 from .experiment import LABELS
 
 __all__ = ["lookup", "render_tables", "render_parameters", "render_headline", "steps_of"]
@@ -26,11 +27,7 @@ def steps_of(records, part: str) -> list[int]:
 
 
 def _ci(v, digits: int = 2) -> str:
-    if v is None:
-        return "—"
-    value, _, se = v
-    return (f"{value:.{digits}f} ± {1.96 * se:.{digits}f}" if se is not None
-            else f"{value:.{digits}f}")
+    return mean_ci(v, digits)
 
 
 def _methods(tab) -> list[str]:
@@ -172,10 +169,7 @@ def render_tables(summary: Mapping[str, Any]) -> str:
     recs = summary["records"]
     L = (_env_tables(recs) + _wrong_table(recs) + _heading_table(recs) + _coef_table(recs)
          + _timing_tables(summary))
-    if "wall_s" in summary:
-        L.append(f"Wall time of this run: {summary['wall_s']:.0f} s "
-                 f"({summary['workers']} worker(s)).")
-    return "\n".join(L)
+    return "\n".join(L + wall_time_line(summary))
 
 
 def render_parameters(summary: Mapping[str, Any]) -> str:

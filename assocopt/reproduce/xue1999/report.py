@@ -6,6 +6,7 @@ from __future__ import annotations
 from typing import Any, Mapping
 
 from ...tracking.scenarios.xue1999_tracker import METHODS
+from .._report import mean_ci, wall_time_line
 from .experiment import LABELS, METRICS
 
 __all__ = ["lookup", "render_tables", "render_parameters", "render_headline"]
@@ -19,10 +20,7 @@ def lookup(records, part: str, metric: str) -> dict[tuple, tuple]:
 
 
 def _ci(v) -> str:
-    if v is None:
-        return "—"
-    value, _, se = v
-    return f"{value:.3f} ± {1.96 * se:.3f}" if se is not None else f"{value:.3f}"
+    return mean_ci(v, 3)
 
 
 def render_tables(summary: Mapping[str, Any]) -> str:
@@ -59,10 +57,7 @@ def render_tables(summary: Mapping[str, Any]) -> str:
             L.append(f"| {c:g} | {f:g} | " + " | ".join(_ci(tab.get((m, f, c)))
                                                        for m in methods) + " |")
         L.append("")
-    if "wall_s" in summary:
-        L.append(f"Wall time of this run: {summary['wall_s']:.0f} s "
-                 f"({summary['workers']} worker(s)).")
-    return "\n".join(L)
+    return "\n".join(L + wall_time_line(summary))
 
 
 def render_parameters(summary: Mapping[str, Any]) -> str:
