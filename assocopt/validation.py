@@ -19,7 +19,7 @@ from numpy.typing import ArrayLike
 from .errors import InvalidProblemError, ProblemTooLargeError
 
 __all__ = ["MAX_ABS_COST", "MAX_SIZE", "check_cost_dtype", "check_cost_range",
-           "check_sizes", "check_tuples", "require_memory"]
+           "check_sizes", "check_tuples", "finite_floats", "require_memory"]
 
 #: Largest magnitude of a finite cost.  A solution sums at most ``sum(n_s)`` costs, and
 #: ``1e300 * 1e8`` is still far below the float64 maximum (about 1.8e308), so no sum of
@@ -61,6 +61,20 @@ def _object_costs(raw: np.ndarray, what: str) -> np.ndarray:
                 f"{what} entry {_where(idx)} = {_show(v)} is outside the accepted range "
                 f"|cost| <= {MAX_ABS_COST:g}") from None
     return out
+
+
+def finite_floats(values: ArrayLike, what: str,
+                  error: type[Exception] = InvalidProblemError, *,
+                  plural: bool = False) -> np.ndarray:
+    """``values`` as a float64 array, raising ``error`` naming ``what`` when they are
+    not numeric or hold NaN or inf (``plural``: ``what`` names several, "contain")."""
+    try:
+        arr = np.asarray(values, dtype=np.float64)
+    except (TypeError, ValueError) as exc:
+        raise error(f"{what} must be numeric: {exc}") from exc
+    if not np.isfinite(arr).all():
+        raise error(f"{what} {'contain' if plural else 'contains'} NaN or inf")
+    return arr
 
 
 def check_cost_dtype(values: ArrayLike, what: str) -> np.ndarray:

@@ -137,3 +137,22 @@ def test_no_other_figure_writer_in_the_reproductions():
            for needle in ("matplotlib.use(", ".savefig(", "plt.close(")
            if needle in f.read_text(encoding="utf-8")]
     assert not bad, "\n".join(bad)
+
+
+def test_finite_floats_names_the_input_and_raises_the_callers_error():
+    from assocopt.errors import InvalidProblemError
+    from assocopt.tracking.group_matching import InvalidObservationsError, Observations
+    from assocopt.tracking.gating import gate
+    from assocopt.validation import finite_floats
+    out = finite_floats([[1, 2]], "x")
+    assert out.dtype == np.float64 and out.tolist() == [[1.0, 2.0]]
+    with pytest.raises(InvalidProblemError, match="^x contains NaN or inf$"):
+        finite_floats([1.0, math.nan], "x")
+    with pytest.raises(KeyError, match="positions contain NaN or inf"):
+        finite_floats([math.inf], "positions", KeyError, plural=True)
+    with pytest.raises(InvalidProblemError, match="^z must be numeric"):
+        finite_floats(["a"], "z")
+    with pytest.raises(InvalidProblemError, match="z_pred contains NaN"):
+        gate([[math.nan]], [[[1.0]]], [[0.0]])
+    with pytest.raises(InvalidObservationsError, match="positions contain NaN"):
+        Observations([[math.nan, 0.0]], [np.eye(2)], [[1.0]], [1], ("a",))

@@ -30,6 +30,7 @@ import numpy as np
 from numpy.typing import ArrayLike
 
 from ..errors import InvalidProblemError
+from ..validation import finite_floats
 
 __all__ = ["Gate", "chi2_threshold", "predict_measurements", "gate", "pair_statistics"]
 
@@ -100,23 +101,23 @@ def predict_measurements(x: ArrayLike, P: ArrayLike, H: ArrayLike,
     >>> z.tolist(), S.tolist()
     ([[1.0]], [[[1.1]]])
     """
-    X = _finite(x, "x")
+    X = finite_floats(x, "x")
     if X.ndim != 2:
         raise InvalidProblemError(f"x must have shape (n, d), got {X.shape}")
     n, d = X.shape
-    Pm = _finite(P, "P")
+    Pm = finite_floats(P, "P")
     if Pm.shape == (d, d):
         Pm = np.broadcast_to(Pm, (n, d, d))
     if Pm.shape != (n, d, d):
         raise InvalidProblemError(f"P must have shape ({n}, {d}, {d}) or ({d}, {d}), "
                                   f"got {Pm.shape}")
-    Hm = _finite(H, "H")
+    Hm = finite_floats(H, "H")
     if Hm.ndim != 2 or Hm.shape[1] != d:
         raise InvalidProblemError(f"H must have shape (m, {d}), got {Hm.shape}")
     z = X @ Hm.T
     S = np.einsum("ij,njk,lk->nil", Hm, Pm, Hm)
     if R is not None:
-        Rm = _finite(R, "R")
+        Rm = finite_floats(R, "R")
         m = Hm.shape[0]
         if Rm.shape != (m, m):
             raise InvalidProblemError(f"R must have shape ({m}, {m}), got {Rm.shape}")
@@ -178,31 +179,21 @@ def pair_statistics(z_pred: ArrayLike, S: ArrayLike, z: ArrayLike, rows: ArrayLi
 
 
 # ---------------------------------------------------------------- internals
-def _finite(a: ArrayLike, what: str) -> np.ndarray:
-    try:
-        arr = np.asarray(a, dtype=np.float64)
-    except (TypeError, ValueError) as exc:
-        raise InvalidProblemError(f"{what} must be numeric: {exc}") from exc
-    if not np.isfinite(arr).all():
-        raise InvalidProblemError(f"{what} contains NaN or inf")
-    return arr
-
-
 def _check(z_pred, S, z, R):
-    zp = _finite(z_pred, "z_pred")
+    zp = finite_floats(z_pred, "z_pred")
     if zp.ndim == 1:
         zp = zp[:, None]
     if zp.ndim != 2:
         raise InvalidProblemError(f"z_pred must have shape (n, m), got {zp.shape}")
     n, m = zp.shape
-    Z = _finite(z, "z")
+    Z = finite_floats(z, "z")
     if Z.ndim == 1 and m == 1:
         Z = Z[:, None]
     if Z.size == 0:
         Z = Z.reshape(0, m)
     if Z.ndim != 2 or Z.shape[1] != m:
         raise InvalidProblemError(f"z must have shape (M, {m}) like z_pred, got {Z.shape}")
-    Sm = _finite(S, "S")
+    Sm = finite_floats(S, "S")
     if Sm.shape == (m, m):
         Sm = np.broadcast_to(Sm, (n, m, m))
     if Sm.shape != (n, m, m):
@@ -210,7 +201,7 @@ def _check(z_pred, S, z, R):
                                   f"got {Sm.shape}")
     Rm = None
     if R is not None:
-        Rm = _finite(R, "R")
+        Rm = finite_floats(R, "R")
         if Rm.shape == (m, m):
             Sm = Sm + Rm                    # shared noise: fold it into S
             Rm = None

@@ -32,6 +32,7 @@ from numpy.typing import ArrayLike
 from .belief import (InvalidMassError, check_vectors, conflict_matrix, conjunctive_vectors,
                      discount_vectors, zhang_combination_vectors, zhang_conflict_matrix)
 from ..errors import AssocoptError
+from ..validation import finite_floats
 
 __all__ = [
     "MATCH_FRAME", "MEASURES", "SAME_SENSOR_READINGS", "MeasureParams", "Observations",
@@ -129,11 +130,12 @@ class Observations:
     types: tuple
 
     def __post_init__(self) -> None:
-        P = _finite(self.positions, "positions")
+        P = finite_floats(self.positions, "positions", InvalidObservationsError, plural=True)
         if P.ndim != 2 or P.shape[1] != 2:
             raise InvalidObservationsError(f"positions must have shape (N, 2), got {P.shape}")
         n = len(P)
-        C = _finite(self.covariances, "covariances")
+        C = finite_floats(self.covariances, "covariances", InvalidObservationsError,
+                          plural=True)
         if C.shape != (n, 2, 2):
             raise InvalidObservationsError(
                 f"covariances must have shape ({n}, 2, 2), got {C.shape}")
@@ -185,16 +187,6 @@ class Observations:
     def of_sensor(self, s: int) -> np.ndarray:
         """Pooled indices of sensor ``s``'s observations, in pooled order."""
         return np.flatnonzero(self.sensor == s)
-
-
-def _finite(values: ArrayLike, what: str) -> np.ndarray:
-    try:
-        arr = np.asarray(values, dtype=np.float64)
-    except (TypeError, ValueError) as exc:
-        raise InvalidObservationsError(f"{what} must be numeric: {exc}") from exc
-    if not np.isfinite(arr).all():
-        raise InvalidObservationsError(f"{what} contain NaN or inf")
-    return arr
 
 
 # ------------------------------------------------------------- components
