@@ -165,6 +165,10 @@ def test_bad_input_is_named():
         gate([[0.0, 0.0]], -np.eye(2), [[0.0, 0.0]])
     with pytest.raises(InvalidProblemError, match=r"z must have shape \(M, 2\)"):
         gate([[0.0, 0.0]], np.eye(2), [[0.0, 0.0, 1.0]])
+    with pytest.raises(InvalidProblemError, match=r"S must have shape \(1, 2, 2\) or \(2, 2\)"):
+        gate([[0.0, 0.0]], np.eye(3), [[0.0, 0.0]])
+    with pytest.raises(InvalidProblemError, match=r"P must have shape \(1, 2, 2\) or \(2, 2\)"):
+        predict_measurements([[1.0, 0.5]], np.eye(3), [[1.0, 0.0]])
     with pytest.raises(InvalidProblemError, match="gate probability"):
         gate([[0.0, 0.0]], np.eye(2), [[0.0, 0.0]], probability=1.0)
     with pytest.raises(InvalidProblemError, match="clutter_density must be > 0"):

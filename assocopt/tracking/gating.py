@@ -105,12 +105,7 @@ def predict_measurements(x: ArrayLike, P: ArrayLike, H: ArrayLike,
     if X.ndim != 2:
         raise InvalidProblemError(f"x must have shape (n, d), got {X.shape}")
     n, d = X.shape
-    Pm = finite_floats(P, "P")
-    if Pm.shape == (d, d):
-        Pm = np.broadcast_to(Pm, (n, d, d))
-    if Pm.shape != (n, d, d):
-        raise InvalidProblemError(f"P must have shape ({n}, {d}, {d}) or ({d}, {d}), "
-                                  f"got {Pm.shape}")
+    Pm = _per_item(P, "P", n, d)
     Hm = finite_floats(H, "H")
     if Hm.ndim != 2 or Hm.shape[1] != d:
         raise InvalidProblemError(f"H must have shape (m, {d}), got {Hm.shape}")
@@ -193,12 +188,7 @@ def _check(z_pred, S, z, R):
         Z = Z.reshape(0, m)
     if Z.ndim != 2 or Z.shape[1] != m:
         raise InvalidProblemError(f"z must have shape (M, {m}) like z_pred, got {Z.shape}")
-    Sm = finite_floats(S, "S")
-    if Sm.shape == (m, m):
-        Sm = np.broadcast_to(Sm, (n, m, m))
-    if Sm.shape != (n, m, m):
-        raise InvalidProblemError(f"S must have shape ({n}, {m}, {m}) or ({m}, {m}), "
-                                  f"got {Sm.shape}")
+    Sm = _per_item(S, "S", n, m)
     Rm = None
     if R is not None:
         Rm = finite_floats(R, "R")
@@ -209,6 +199,18 @@ def _check(z_pred, S, z, R):
             raise InvalidProblemError(f"R must have shape ({m}, {m}) or ({len(Z)}, {m}, {m}),"
                                       f" got {Rm.shape}")
     return zp, Sm, Z, Rm
+
+
+def _per_item(a: ArrayLike, what: str, n: int, k: int) -> np.ndarray:
+    """``a`` as ``(n, k, k)``: one ``(k, k)`` matrix shared by all ``n`` items (a
+    read-only broadcast view) or one per item."""
+    A = finite_floats(a, what)
+    if A.shape == (k, k):
+        A = np.broadcast_to(A, (n, k, k))
+    if A.shape != (n, k, k):
+        raise InvalidProblemError(f"{what} must have shape ({n}, {k}, {k}) or ({k}, {k}), "
+                                  f"got {A.shape}")
+    return A
 
 
 def _threshold(probability: float, threshold: float | None, m: int) -> float:
