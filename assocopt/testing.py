@@ -31,7 +31,7 @@ import numpy as np
 from .problem import AssignmentProblem
 from .solution import Solution, Status
 
-__all__ = ["KINDS", "random_problem", "problems", "generated_problems", "assert_optimal",
+__all__ = ["KINDS", "random_problem", "random_scans", "problems", "generated_problems", "assert_optimal",
            "assert_feasible", "assert_valid_bound", "reference_optimum", "stored_instances",
            "BRUTE_FORCE_MAX_CANDIDATES"]
 
@@ -90,6 +90,28 @@ def _random_sd(rng: np.random.Generator, sizes: tuple[int, ...] | None, integer:
     single = (T > 0).sum(axis=1) == 1
     costs[single] = np.abs(costs[single])   # false alarms: a non-negative cost
     return AssignmentProblem.sparse(sizes, T, costs)
+
+
+def random_scans(rng: np.random.Generator, n_sensors: int, n_targets: int, *,
+                 pd: float, clutter: float, sigma: float) -> list[np.ndarray]:
+    """One scan per sensor of ``n_targets`` targets placed uniformly in the unit square:
+    each target is detected with probability ``pd`` and seen with Gaussian position
+    noise ``sigma``, plus Poisson(``clutter``) false alarms uniform in the square; each
+    scan is an ``(M_s, 2)`` array in random order (the measurements behind
+    tracking-like S-D test problems).
+
+    >>> scans = random_scans(np.random.default_rng(0), 3, 4, pd=1.0, clutter=0.0, sigma=0.01)
+    >>> [z.shape for z in scans]
+    [(4, 2), (4, 2), (4, 2)]
+    """
+    targets = rng.random((n_targets, 2))
+    scans = []
+    for _ in range(n_sensors):
+        seen = targets[rng.random(n_targets) < pd]
+        fa = rng.random((rng.poisson(clutter), 2))
+        z = np.concatenate([seen + rng.normal(0, sigma, seen.shape), fa])
+        scans.append(z[rng.permutation(len(z))])
+    return scans
 
 
 def _hypothesis(helper: str = "draw_costs") -> Any:

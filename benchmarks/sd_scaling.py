@@ -46,6 +46,7 @@ sys.path.insert(0, str(ROOT))
 from assocopt import AssignmentProblem, Status, solve  # noqa: E402
 from assocopt.io import write_text_atomically  # noqa: E402
 from assocopt.solvers import registered  # noqa: E402
+from assocopt.testing import random_scans  # noqa: E402
 
 PEERS = ("highs", "scipy", "ortools-cpsat")
 #: our exact methods, run on every instance: the one the user gets by default
@@ -135,13 +136,7 @@ def tracking(rng: np.random.Generator, N: int, n_targets: int, pd: float = 0.8,
     Poisson(clutter) false alarms; tuples gated on the distance to their centroid;
     cost = -log likelihood ratio against "all false alarms" (single-measurement
     tuples cost 0)."""
-    targets = rng.random((n_targets, 2))
-    meas = []
-    for _ in range(N):
-        seen = targets[rng.random(n_targets) < pd]
-        fa = rng.random((rng.poisson(clutter), 2))
-        z = np.concatenate([seen + rng.normal(0, sigma, seen.shape), fa])
-        meas.append(z[rng.permutation(len(z))])
+    meas = random_scans(rng, N, n_targets, pd=pd, clutter=clutter, sigma=sigma)
     sizes = tuple(len(z) for z in meas)
     gate = gate_sigmas * sigma * math.sqrt(2)
     parts, psum, pcnt = np.zeros((1, 0), np.int64), np.zeros((1, 2)), np.zeros(1)

@@ -24,7 +24,7 @@ from assocopt.solvers import lagrangian as lg
 from assocopt.solvers import registered
 from assocopt.solvers.lap import (LapInfeasibleError, assign_with_misses,
                                   assignment_duals, lapx_available, linear_assignment)
-from assocopt.testing import assert_feasible, assert_optimal, random_problem
+from assocopt.testing import assert_feasible, assert_optimal, random_problem, random_scans
 
 from conftest import AP_INSTANCES, sd_problems
 
@@ -411,13 +411,7 @@ def test_plain_mode_gap_on_tracking_like_instances():
 def _tracking(rng, N, n_targets, pd=0.9, clutter=1.0, sigma=0.02, gate=0.12):
     """Sensors measuring 2-D target positions with misses and false alarms; tuples
     gated on mutual distance; negative log-likelihood-ratio costs."""
-    targets = rng.random((n_targets, 2))
-    meas = []
-    for _ in range(N):
-        seen = targets[rng.random(n_targets) < pd]
-        fa = rng.random((rng.poisson(clutter), 2))
-        z = np.concatenate([seen + rng.normal(0, sigma, seen.shape), fa])
-        meas.append(z[rng.permutation(len(z))])
+    meas = random_scans(rng, N, n_targets, pd=pd, clutter=clutter, sigma=sigma)
     sizes = tuple(len(z) for z in meas)
     parts = np.zeros((1, 0), np.int64)
     for s in range(N):
