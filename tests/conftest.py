@@ -1,9 +1,11 @@
 """Shared fixtures: the back ends under test, the public benchmark folder, the
-small random S-D problems the Lagrangian and branch-and-bound tests draw, and the
-check that a paper page's generated blocks match its committed summary."""
+small random S-D problems the Lagrangian and branch-and-bound tests draw, the
+check that a paper page's generated blocks match its committed summary, and loading
+the repository's scripts (benchmarks/, docs/) as modules."""
 
 from __future__ import annotations
 
+import importlib.util
 import json
 import re
 from pathlib import Path
@@ -15,6 +17,7 @@ from assocopt import AssignmentProblem
 from assocopt.solvers import registered
 from assocopt.testing import draw_costs, draw_sd
 
+ROOT = Path(__file__).resolve().parents[1]
 #: ../shared/ap_instances beside the project checkout (absent for installed users).
 AP_INSTANCES = Path(__file__).resolve().parents[2] / "shared" / "ap_instances"
 
@@ -89,3 +92,12 @@ def check_page_against_summary(repro, paper: str, page: Path, summary_path: Path
     for f in summary["figures"]:
         assert (summary_path.parent / f).is_file() and f"{paper}/{f}" in text
     return summary
+
+
+def load_script(path: str, name: str):
+    """The repository script ``path`` (relative to the checkout, e.g.
+    ``"benchmarks/twod.py"``) executed as a fresh module called ``name``."""
+    spec = importlib.util.spec_from_file_location(name, ROOT / path)
+    mod = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(mod)
+    return mod

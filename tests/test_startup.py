@@ -14,6 +14,8 @@ from pathlib import Path
 
 import pytest
 
+from conftest import load_script
+
 ROOT = Path(__file__).resolve().parents[1]
 HEAVY = ("scipy.sparse", "scipy.optimize", "numba", "highspy", "ortools", "cvxpy",
          "matplotlib")
@@ -130,11 +132,7 @@ def test_solvers_are_reachable_as_attributes():
 
 # ------------------------------------------------------------------ the docs page
 def _bench():
-    spec = importlib.util.spec_from_file_location("startup_bench",
-                                                  ROOT / "benchmarks" / "startup.py")
-    mod = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(mod)
-    return mod
+    return load_script("benchmarks/startup.py", "startup_bench")
 
 
 def test_startup_page_is_rendered_from_the_committed_measurements():

@@ -2,19 +2,16 @@
 
 from __future__ import annotations
 
-import importlib.util
 import json
 from pathlib import Path
+
+from conftest import load_script
 
 ROOT = Path(__file__).resolve().parents[1]
 
 
 def _script():
-    spec = importlib.util.spec_from_file_location("stonesoup_assoc",
-                                                  ROOT / "benchmarks" / "stonesoup_assoc.py")
-    mod = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(mod)
-    return mod
+    return load_script("benchmarks/stonesoup_assoc.py", "stonesoup_assoc")
 
 
 def test_page_is_the_rendering_of_the_json():

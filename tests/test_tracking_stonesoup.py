@@ -164,13 +164,8 @@ def test_k_best_joint_hypotheses_equal_stone_soups_enumeration(k):
 
 
 def test_guide_figure_script_draws_both_loops(tmp_path):
-    import importlib.util
-    from pathlib import Path
-
-    path = Path(__file__).resolve().parents[1] / "docs" / "tracking_figure.py"
-    spec = importlib.util.spec_from_file_location("tracking_figure", path)
-    mod = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(mod)
+    from conftest import load_script
+    mod = load_script("docs/tracking_figure.py", "tracking_figure")
     assert len(mod.section_blocks()) == 2
     out = mod.main(["--out", str(tmp_path / "fig.png")])
     assert out.stat().st_size > 10_000
