@@ -1,7 +1,8 @@
 """Shared fixtures: the back ends under test, the public benchmark folder, the
 small random S-D problems the Lagrangian and branch-and-bound tests draw, the
-check that a paper page's generated blocks match its committed summary, and loading
-the repository's scripts (benchmarks/, docs/) as modules."""
+check that a paper page's generated blocks match its committed summary (and the rerun
+of one of its cells), and loading the repository's scripts (benchmarks/, docs/) as
+modules."""
 
 from __future__ import annotations
 
@@ -9,6 +10,7 @@ import importlib.util
 import json
 import re
 from pathlib import Path
+from typing import Any, Callable
 
 import pytest
 from hypothesis import strategies as st
@@ -101,3 +103,19 @@ def load_script(path: str, name: str):
     mod = importlib.util.module_from_spec(spec)
     spec.loader.exec_module(mod)
     return mod
+
+
+def rerun_committed(repro, paper: str, part: str, where: Callable[[dict], bool],
+                    store: Path) -> tuple[list[dict[str, Any]], list[dict[str, Any]]]:
+    """Recompute from scratch, into ``store``, the settings of experiment ``part`` of the
+    committed run of ``paper`` that ``where(setting)`` selects (with that run's run
+    count and seed); returns the summarised rows and the committed records of the
+    same settings, to compare."""
+    from assocopt.experiments import Experiment, run_experiment, summarise
+    js = json.loads((ROOT / "docs" / "papers" / paper / "summary.json").read_text())
+    exp = repro.experiments(js["runs"], js["seed"], parts=(part,))[0]
+    one = Experiment(exp.name, [s for s in exp.settings if where(s)], exp.methods,
+                     exp.trial, exp.runs, exp.seed, exp.params, exp.volatile)
+    run_experiment(one, store)
+    committed = [r for r in js["records"] if r["experiment"] == part and where(r["setting"])]
+    return summarise(store, one), committed

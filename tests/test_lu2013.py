@@ -16,6 +16,7 @@ from assocopt.reproduce import lu2013 as L
 from assocopt import lp_fixing
 from assocopt.tracking.scenarios.lu2013 import PAPER_SENSORS_KM, Lu2013
 from assocopt.solvers.bruteforce import enumerate_solutions
+from conftest import rerun_committed
 
 
 # ---------------------------------------------------------------------- scenario
@@ -247,18 +248,10 @@ def test_pinned_fig_trial():
 def test_committed_summary_regenerates_from_the_code(tmp_path):
     """Recompute one cell of the committed run from scratch (the region scan's L = 20,
     its full run count) and compare with docs/papers/lu2013/summary.json exactly."""
-    from pathlib import Path
-    from assocopt.experiments import Experiment, run_experiment, summarise
-    js = json.loads((Path(__file__).resolve().parents[1] / "docs/papers/lu2013/summary.json")
-                    .read_text())
-    exp = L.experiments(js["runs"], js["seed"], parts=("region",))[0]
-    one = Experiment(exp.name, [s for s in exp.settings if s["L"] == 20.0], exp.methods,
-                     exp.trial, exp.runs, exp.seed, exp.params, exp.volatile)
-    run_experiment(one, tmp_path / "r.sqlite")
-    mine = {r["metric"]: r["value"] for r in summarise(tmp_path / "r.sqlite", one)}
-    committed = {r["metric"]: r["value"] for r in js["records"]
-                 if r["experiment"] == "region" and r["setting"]["L"] == 20.0
-                 and not r["volatile"] and not r["paired"]}
+    rows, recs = rerun_committed(L, "lu2013", "region", lambda s: s["L"] == 20.0,
+                                 tmp_path / "r.sqlite")
+    mine = {r["metric"]: r["value"] for r in rows}
+    committed = {r["metric"]: r["value"] for r in recs if not r["volatile"] and not r["paired"]}
     assert committed and mine["tuple_rate"] == committed["tuple_rate"]
     assert {k: mine[k] for k in committed} == pytest.approx(committed, rel=1e-12)
 

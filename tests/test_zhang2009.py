@@ -14,7 +14,7 @@ from assocopt.tracking.decide import (TruncationOptions, gate_threshold, md_2da,
 from assocopt.tracking.group_matching import MeasureParams, matching_matrix
 from assocopt.tracking.scenarios.zhang2009 import Zhang2009, confusion_sets, mean_nearest_distance
 
-from conftest import EXACT, installed
+from conftest import EXACT, installed, rerun_committed
 
 NCR = MeasureParams("ncr", r_p=1.0, r_a=0.6)
 
@@ -319,17 +319,9 @@ def test_covariance_scale_is_a_real_parameter():
 def test_committed_summary_regenerates_from_the_code(tmp_path):
     """Recompute one point of the committed run from scratch (Exp. 1b, k = 1, its full
     run count) and compare with docs/papers/zhang2009/summary.json exactly."""
-    import json
-    from pathlib import Path
-    from assocopt.experiments import Experiment, run_experiment, summarise
     from assocopt.reproduce import zhang2009 as repro
-    js = json.loads((Path(__file__).resolve().parents[1] / "docs/papers/zhang2009/summary.json")
-                    .read_text())
-    exp = repro.experiments(js["runs"], js["seed"], parts=("weights",))[0]
-    one = Experiment(exp.name, [s for s in exp.settings if s["k"] == 1], exp.methods,
-                     exp.trial, exp.runs, exp.seed, exp.params, exp.volatile)
-    run_experiment(one, tmp_path / "w.sqlite")
-    mine = {(r["method"], r["metric"]): r["value"] for r in summarise(tmp_path / "w.sqlite", one)}
-    committed = {(r["method"], r["metric"]): r["value"] for r in js["records"]
-                 if r["experiment"] == "weights" and r["setting"]["k"] == 1 and not r["volatile"]}
+    rows, recs = rerun_committed(repro, "zhang2009", "weights", lambda s: s["k"] == 1,
+                                 tmp_path / "w.sqlite")
+    mine = {(r["method"], r["metric"]): r["value"] for r in rows}
+    committed = {(r["method"], r["metric"]): r["value"] for r in recs if not r["volatile"]}
     assert committed and {k: mine[k] for k in committed} == pytest.approx(committed, rel=1e-12)
