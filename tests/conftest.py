@@ -1,14 +1,17 @@
 """Shared fixtures: the back ends under test, the public benchmark folder, the
 small random S-D problems the Lagrangian and branch-and-bound tests draw, the
 check that a paper page's generated blocks match its committed summary (and the rerun
-of one of its cells), and loading the repository's scripts (benchmarks/, docs/) as
-modules."""
+of one of its cells), loading the repository's scripts (benchmarks/, docs/) as
+modules, and running code in a fresh interpreter (import checks)."""
 
 from __future__ import annotations
 
 import importlib.util
 import json
+import os
 import re
+import subprocess
+import sys
 from pathlib import Path
 from typing import Any, Callable
 
@@ -119,3 +122,11 @@ def rerun_committed(repro, paper: str, part: str, where: Callable[[dict], bool],
     run_experiment(one, store)
     committed = [r for r in js["records"] if r["experiment"] == part and where(r["setting"])]
     return summarise(store, one), committed
+
+
+def fresh_python(code: str, *, cwd: Path | None = None) -> str:
+    """The standard output of ``code`` run by a fresh interpreter on this checkout
+    (``PYTHONPATH`` = the checkout); a non-zero exit fails the test."""
+    env = dict(os.environ, PYTHONPATH=str(ROOT))
+    return subprocess.run([sys.executable, "-c", code], cwd=cwd, env=env, check=True,
+                          capture_output=True, text=True).stdout

@@ -14,6 +14,8 @@ from pathlib import Path
 
 import pytest
 
+from conftest import fresh_python
+
 ROOT = Path(__file__).resolve().parents[1]
 INSTANCES = ROOT / "instances"
 PACKAGED = ROOT / "assocopt" / "data" / "instances"
@@ -73,9 +75,7 @@ def test_problems_without_hypothesis_names_the_install():
             "    except MissingDependencyError as exc:\n        print(exc)\n"
             "    else:\n        raise SystemExit('no error')\n"
             "print(t.random_problem.__name__)\n")
-    env = dict(os.environ, PYTHONPATH=str(ROOT))
-    out = subprocess.run([sys.executable, "-c", code], env=env, capture_output=True,
-                         text=True, check=True).stdout.splitlines()
+    out = fresh_python(code).splitlines()
     assert len(out) == 3
     for line in out[:2]:
         assert "pip install hypothesis" in line and "assocopt[dev]" in line

@@ -16,6 +16,8 @@ from pathlib import Path
 
 import pytest
 
+from conftest import fresh_python
+
 ROOT = Path(__file__).resolve().parents[1]
 PKG = ROOT / "assocopt"
 
@@ -256,13 +258,9 @@ def test_no_reference_to_files_the_project_does_not_ship():
 
 def test_a_plain_model_does_not_load_the_tracking_layer():
     """The cost layer is looked up only for models with a [cost] table."""
-    import subprocess
-    import sys
-
     code = ("import sys, assocopt.models as m; m.load_model('highs-ilp');"
             "print(any(k.startswith('assocopt.tracking') for k in sys.modules));"
             "m.load_model('lu2013-pattipati');"
             "print(any(k.startswith('assocopt.tracking') for k in sys.modules))")
-    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
-                         cwd=ROOT, check=True).stdout.split()
+    out = fresh_python(code, cwd=ROOT).split()
     assert out == ["False", "True"]

@@ -7,14 +7,11 @@ from __future__ import annotations
 
 import importlib.util
 import json
-import os
-import subprocess
-import sys
 from pathlib import Path
 
 import pytest
 
-from conftest import load_script
+from conftest import fresh_python, load_script
 
 ROOT = Path(__file__).resolve().parents[1]
 HEAVY = ("scipy.sparse", "scipy.optimize", "numba", "highspy", "ortools", "cvxpy",
@@ -23,10 +20,8 @@ HEAVY = ("scipy.sparse", "scipy.optimize", "numba", "highspy", "ortools", "cvxpy
 
 def _loaded(code: str, cwd: Path = ROOT) -> set[str]:
     """Module names loaded after running ``code`` in a fresh interpreter."""
-    env = dict(os.environ, PYTHONPATH=str(ROOT))
-    script = code + "\nimport sys, json\nprint(json.dumps(sorted(sys.modules)))"
-    out = subprocess.run([sys.executable, "-c", script], cwd=cwd, env=env, check=True,
-                         capture_output=True, text=True).stdout
+    out = fresh_python(code + "\nimport sys, json\nprint(json.dumps(sorted(sys.modules)))",
+                       cwd=cwd)
     return set(json.loads(out.splitlines()[-1]))
 
 
@@ -173,8 +168,6 @@ def test_every_back_end_module_is_declared():
             "    if 'kernels' not in m.name:\n"
             "        importlib.import_module(m.name)\n"
             "print(json.dumps([declared, sorted(s.registered())]))\n")
-    env = dict(os.environ, PYTHONPATH=str(ROOT))
-    out = subprocess.run([sys.executable, "-c", code], env=env, check=True,
-                         capture_output=True, text=True).stdout
+    out = fresh_python(code)
     declared, registered = json.loads(out.splitlines()[-1])
     assert declared == registered and len(declared) >= 12

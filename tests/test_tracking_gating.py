@@ -14,6 +14,7 @@ from assocopt import solve
 from assocopt.errors import InvalidProblemError
 from assocopt.tracking.costs import kinematic as kin
 from assocopt.tracking.gating import gate, pair_statistics, predict_measurements
+from conftest import fresh_python
 
 
 def _random_scan(rng, n, M, m, spread=10.0):
@@ -188,12 +189,7 @@ def test_empty_scans():
 
 
 def test_the_core_never_imports_tracking():
-    import subprocess
-    import sys
-
     code = ("import sys, assocopt, assocopt.api, assocopt.problem, assocopt.solvers, "
             "assocopt.io, assocopt.cli; "
             "print(any(m.startswith('assocopt.tracking') for m in sys.modules))")
-    res = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
-                         check=True)
-    assert res.stdout.strip() == "False"
+    assert fresh_python(code).strip() == "False"

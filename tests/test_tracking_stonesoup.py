@@ -2,7 +2,6 @@
 
 from __future__ import annotations
 
-import sys
 from datetime import datetime, timedelta
 
 import numpy as np
@@ -26,6 +25,7 @@ from stonesoup.updater.kalman import KalmanUpdater  # noqa: E402
 from assocopt.tracking.simulate import CVScenario  # noqa: E402
 from assocopt.tracking.stonesoup import (AssocoptGNN, AssocoptKBest,  # noqa: E402
                                          hypotheses_problem)
+from conftest import fresh_python  # noqa: E402
 
 START = datetime(2026, 1, 1)
 
@@ -119,25 +119,17 @@ def test_problem_from_hypotheses_has_the_miss_candidates():
 
 
 def test_missing_stonesoup_names_the_extra():
-    import subprocess
-
     code = ("import sys; sys.modules['stonesoup'] = None\n"
             "try:\n    import assocopt.tracking.stonesoup\n"
             "except ImportError as exc:\n    print(exc)")
-    res = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
-                         check=True)
-    assert "pip install assocopt[stonesoup]" in res.stdout
+    assert "pip install assocopt[stonesoup]" in fresh_python(code)
 
 
 def test_importing_tracking_does_not_import_stonesoup():
-    import subprocess
-
     code = ("import sys, assocopt.tracking, assocopt.tracking.gating, "
             "assocopt.tracking.costs.kinematic, assocopt.tracking.sd_gating; "
             "print('stonesoup' in sys.modules)")
-    res = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
-                         check=True)
-    assert res.stdout.strip() == "False"
+    assert fresh_python(code).strip() == "False"
 
 
 @pytest.mark.parametrize("k", [1, 4, 50])
