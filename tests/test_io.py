@@ -82,7 +82,10 @@ def test_grundel_without_sol_has_no_optimum_and_2d(tmp_path):
 def test_grundel_ap3_opt_table_fallback(tmp_path):
     f = write(tmp_path / "ap3.2.7.txt", grundel_text((2, 2, 2), range(8)))
     write(tmp_path / "ap3.opt", "ap3.2.6  1\nap3.2.7  7\n")
-    assert read_instance(f).optimum == 7.0
+    p = read_instance(f)
+    assert p.optimum == 7.0 and p.meta["optimum_source"] == "ap3.opt"
+    g = write(tmp_path / "ap3.2.8.txt", grundel_text((2, 2, 2), range(8)))
+    assert read_instance(g).optimum is None          # not listed
 
 
 def test_grundel_truncated(tmp_path):
@@ -224,6 +227,7 @@ def test_orlib_and_assignopt(tmp_path):
     assert detect_format(f) == "orlib"
     p = read_instance(f)
     assert p.sizes == (3, 3) and p.name == "assign3" and p.optimum == 8.0
+    assert p.meta["optimum_source"] == "assignopt.txt"
     assert p.to_cost_matrix()[0, 2] == 9.0
     assert assocopt.solve(p, "highs").objective == 8.0
 

@@ -136,6 +136,17 @@ def _dense(path: Path, values: np.ndarray, shape: tuple[int, ...], name: str,
     return p
 
 
+def _listed_optimum(table: Path, name: str) -> float | None:
+    """The optimum the table ``table`` (lines ``NAME VALUE``) lists for ``name``, or
+    ``None`` when it lists none (callers catch :class:`OSError`)."""
+    if table.is_file():
+        for line in table.read_text(encoding="utf-8", errors="replace").splitlines():
+            parts = line.split()
+            if len(parts) == 2 and parts[0] == name and _NUMBER.match(parts[1]):
+                return float(parts[1])
+    return None
+
+
 def _count_error(path: Path, expected: int, found: int, what: str = "") -> InstanceFormatError:
     where = f"{what}: " if what else ""
     more = "truncated file?" if found < expected else "extra numbers at the end?"

@@ -12,7 +12,8 @@ import re
 from pathlib import Path
 
 from ..problem import AssignmentProblem
-from .common import _NUMBER, _count_error, _dense, _fail, _header_int, _lines, _numbers
+from .common import (_NUMBER, _count_error, _dense, _fail, _header_int, _lines,
+                     _listed_optimum, _numbers)
 
 #: Largest dimension count accepted in a Grundel header.
 _MAX_D = 16
@@ -54,12 +55,9 @@ def _grundel_optimum(path: Path) -> tuple[float | None, str | None]:
                     if m and _NUMBER.match(m.group(1)):
                         return float(m.group(1)), f"{sol.name} (OPT line)"
                     break
-        table = path.parent / "ap3.opt"
-        if table.is_file():
-            for line in table.read_text(encoding="utf-8", errors="replace").splitlines():
-                parts = line.split()
-                if len(parts) == 2 and parts[0] == path.stem and _NUMBER.match(parts[1]):
-                    return float(parts[1]), "ap3.opt"
+        listed = _listed_optimum(path.parent / "ap3.opt", path.stem)
+        if listed is not None:
+            return listed, "ap3.opt"
     except OSError:
         pass
     return None, None

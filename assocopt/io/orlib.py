@@ -9,7 +9,7 @@ from __future__ import annotations
 from pathlib import Path
 
 from ..problem import AssignmentProblem
-from .common import _NUMBER, _count_error, _dense, _fail, _header_int, _numbers
+from .common import _count_error, _dense, _fail, _header_int, _listed_optimum, _numbers
 
 
 def _read_orlib(path: Path, text: str) -> AssignmentProblem:
@@ -26,13 +26,8 @@ def _read_orlib(path: Path, text: str) -> AssignmentProblem:
 
 
 def _orlib_optimum(path: Path) -> tuple[float | None, str | None]:
-    table = path.parent / "assignopt.txt"
     try:
-        if table.is_file():
-            for line in table.read_text(encoding="utf-8", errors="replace").splitlines():
-                parts = line.split()
-                if len(parts) == 2 and parts[0] == path.stem and _NUMBER.match(parts[1]):
-                    return float(parts[1]), "assignopt.txt"
+        listed = _listed_optimum(path.parent / "assignopt.txt", path.stem)
     except OSError:
-        pass
-    return None, None
+        listed = None
+    return (listed, "assignopt.txt") if listed is not None else (None, None)
