@@ -105,7 +105,7 @@ def test_gated_candidate_list_is_solved_sparse():
 
     p = gated_2d(3000, 5, seed=0)
     sol = solve(p)
-    assert sol.status is Status.OPTIMAL and sol.info["lsa_mode"] == "sparse-augmented"
+    assert sol.status is Status.OPTIMAL and sol.info["lsa_mode"] == "sparse-reduced"
 
 
 @settings(max_examples=200, deadline=None)

@@ -42,7 +42,8 @@ from scipy.optimize import linear_sum_assignment as _scipy_lsa
 from ..solution import Status
 from .base import RawResult, empty_answer
 from .lap import LapInfeasibleError, linear_assignment
-from .sparse2d import assign_sparse, prefer_sparse
+from .sparse2d import (assign_sparse_edges, prefer_sparse, selected_from_edges,
+                       split_candidates)
 
 __all__ = ["assign_dense", "clipped_matrix", "solve_2d"]
 
@@ -176,20 +177,18 @@ def solve_2d(problem, options, engine: str, label: str, mode: str = "auto"):
             cor, how = assign_dense(d.C, d.rm, d.cm, d.slack, engine, d.miss_flags)
             selected = None
         else:
-            T, c = problem.tuples, problem.costs
-            both = (T[:, 0] > 0) & (T[:, 1] > 0)
-            rm, cm = problem.miss_costs()
+            rows, cols, w, pos, rm, cm, rpos, cpos = split_candidates(problem)
             n1, n2 = problem.sizes
-            rows, cols, w = T[both, 0] - 1, T[both, 1] - 1, c[both]
             t1 = time.perf_counter()
             if mode == "sparse" or (mode == "auto" and
                                     prefer_sparse(problem.sizes, len(w))):
-                cor, how = assign_sparse(n1, n2, rows, cols, w, rm, cm)
+                edge, how = assign_sparse_edges(n1, n2, rows, cols, w, rm, cm)
+                selected = selected_from_edges(edge, cols, pos, rpos, cpos)
             else:
                 C = np.full((n1, n2), np.inf)
                 C[rows, cols] = w
                 cor, how = assign_dense(C, rm, cm, False, engine)
-            selected = _answer_positions(problem, cor)
+                selected = _answer_positions(problem, cor)
     except LapInfeasibleError as exc:
         return RawResult(Status.INFEASIBLE, message=f"{label}: infeasible ({exc})",
                          build_time=t1 - t0, solve_time=time.perf_counter() - t1)
