@@ -189,7 +189,8 @@ def lap_edges(nr: int, nc: int, rows: np.ndarray, cols: np.ndarray,
         size = 0
         i = cur
         low = 0.0
-        sink = -1
+        best = np.inf           # label of the closest free column reached so far ...
+        sink = -1               # ... and that column (never pushed on the heap)
         while True:
             seen[ns] = i
             ns += 1
@@ -199,32 +200,36 @@ def lap_edges(nr: int, nc: int, rows: np.ndarray, cols: np.ndarray,
                 if done[j]:
                     continue
                 r = base + cost[e] - v[j]
-                if r < dist[j]:
+                if r < dist[j] and r < best:      # no use beyond the closest free one
                     if dist[j] == np.inf:
                         touched[nt] = j
                         nt += 1
                     dist[j] = r
                     via[j] = e
                     prev[j] = i
-                    size = _push(hk, hv, size, r, j)
+                    if row4col[j] < 0:
+                        best = r
+                        sink = j
+                    else:
+                        size = _push(hk, hv, size, r, j)
             j = -1
             while size > 0:
                 key = hk[0]
+                if key >= best:
+                    break
                 top = hv[0]
                 size = _pop(hk, hv, size)
                 if not done[top] and key <= dist[top]:
                     j = top
                     break
             if j < 0:
-                for t in range(nt):
-                    dist[touched[t]] = np.inf
-                    done[touched[t]] = False
-                return np.empty(0, np.int64), cur
+                if sink < 0:
+                    return np.empty(0, np.int64), cur
+                low = best
+                done[sink] = True
+                break
             low = dist[j]
             done[j] = True
-            if row4col[j] < 0:
-                sink = j
-                break
             i = row4col[j]
         u[cur] += low
         for s in range(1, ns):
