@@ -295,10 +295,11 @@ class LapjvBackend(Backend):
     name = "lapjv"
     module = "lap"
     distribution = "lapx"
-    description = "lapx Jonker-Volgenant LAP (dense) / scipy LAPJVsp (sparse), 2-D only"
+    description = ("lapx Jonker-Volgenant LAP (dense) / compiled sparse LAP (gated lists), "
+                   "2-D only")
     max_ndim = 2
     options = (Option("method", "choice", "auto", "LAP engine: lapx (dense; 'auto' "
-                      "means lapx) or scipy's sparse LAPJVsp",
+                      "means lapx) or the sparse engine of gated lists",
                       choices=("auto", "lapx", "sparse")),)
 
     def solve(self, problem: AssignmentProblem, options: SolveOptions) -> RawResult:
