@@ -1,6 +1,8 @@
-"""numba kernels of the ``bnb`` back end and the compiled window search of
-``lagrangian-exact``; imported only when one of them runs (importing numba costs
-half a second).  :mod:`assocopt.solvers.bnb_kernels` is the one import point.
+"""numba kernels of the ``bnb`` back end, the compiled window search of
+``lagrangian-exact`` and the sparse 2-D LAP (:mod:`.sparse_lap`, imported by
+:mod:`assocopt.solvers.sparse2d`); imported only when one of them runs (importing
+numba costs half a second).  :mod:`assocopt.solvers.bnb_kernels` is the import point
+of the ``bnb`` kernels.
 
 This package file itself imports no numba: it holds the clock of compilation and
 cache loading (:func:`ensure`, :func:`spent`), which :func:`assocopt.solve` reads
