@@ -207,3 +207,23 @@ def test_infeasible_scan_is_reported():
     sol = solve(_problem(n, n, rows, cols, w, rm, cm))
     assert sol.status is Status.INFEASIBLE and "must be assigned" in sol.message, \
         sol.message
+
+
+@pytest.mark.parametrize("nr, nc, density, levels, seed", [
+    (60, 60, 0.2, 3, 0), (80, 120, 0.1, 2, 1), (150, 150, 0.05, 1000, 2),
+    (100, 140, 0.5, 1, 3), (120, 120, 1.0, 4, 4)])
+def test_kernel_matches_dense_scipy_with_ties(nr, nc, density, levels, seed):
+    """Larger problems with many equal costs (the tie branches of the row reduction),
+    negative costs and a full-density case, against linear_sum_assignment."""
+    from assocopt.solvers.kernels.sparse_lap import lap_edges
+
+    rng = np.random.default_rng(seed)
+    M = rng.integers(-levels // 2, levels, size=(nr, nc)).astype(float)
+    M[rng.random(M.shape) > density] = np.inf
+    M[np.arange(nr), rng.permutation(nc)[:nr]] = 5.0 * levels    # always feasible
+    r, c = np.nonzero(np.isfinite(M))
+    edge, bad = lap_edges(nr, nc, r, c, M[r, c])
+    ri, ci = linear_sum_assignment(M)
+    assert bad == -1
+    assert np.array_equal(r[edge], np.arange(nr)) and len(set(c[edge].tolist())) == nr
+    assert M[r[edge], c[edge]].sum() == M[ri, ci].sum()
