@@ -106,6 +106,14 @@ def kbest(problem: AssignmentProblem, k: int, solver: str = "auto", **options: A
             f"problem must be an AssignmentProblem, got {type(problem).__name__}")
     if isinstance(k, bool) or not isinstance(k, (int, np.integer)) or k < 1:
         raise InvalidProblemError(f"k must be a positive integer, got {k!r}")
+    if problem.ndim == 2 and solver == "auto" and not options:
+        from . import kbest2d
+
+        fast = kbest2d.kbest_2d(problem, int(k)) if kbest2d.available() else None
+        if fast is not None:
+            sols, exhausted, solved, times = fast
+            return Ranked(sols, int(k), exhausted, kbest2d.NAME, solved,
+                          times={**times, "total": time.perf_counter() - t0})
     engine = _TWO_D_SOLVERS.get(solver) if problem.ndim == 2 and not options else None
     if engine is not None and (problem.dense_view is not None or
                                problem.sizes[0] * problem.sizes[1] <= _DENSIFY_MAX):

@@ -1,12 +1,13 @@
-"""Murty's ranked assignments on a square matrix, each subproblem solved from its
-parent's solution and duals by one shortest augmenting path; compiled with numba.
+"""Murty's ranked assignments, each subproblem solved from its parent's solution and
+duals by one shortest augmenting path; compiled with numba.
 
-The matrix ``A`` (``N x N``, ``inf`` = forbidden) is a 2-D problem in LAP form
-(:mod:`assocopt.kbest2d` builds it); its first ``P`` rows are the *real* rows, whose
-choices of column define a 2-D solution, the others are dummy rows whose assignment
-follows from the real rows' (up to equal-cost permutations among zero-cost dummy
-entries).  Murty's partition is taken over the real rows only, so every 2-D solution
-is reported exactly once, however many LAP solutions map to it.
+The matrix ``A`` (``nr x nc``, ``nr <= nc``, ``inf`` = forbidden; every row assigned,
+columns free at no cost) is a 2-D problem in LAP form (:mod:`assocopt.kbest2d` builds
+it); its first ``P`` rows are the *real* rows, whose choices of column define a 2-D
+solution, any others are dummy rows whose assignment follows from the real rows' (up to
+equal-cost permutations among zero-cost dummy entries).  Murty's partition is taken
+over the real rows only, so every 2-D solution is reported exactly once, however many
+LAP solutions map to it.
 
 A subproblem is ``(fixed rows, forbidden pairs)``.  When the best solution ``x`` of a
 subproblem is reported, its free real rows ``r_1 .. r_m`` (in an order chosen below)
@@ -14,19 +15,20 @@ give the children "``r_1 .. r_{t-1}`` keep their columns, ``r_t`` loses its colu
 ``x[r_t]``", ``t = 1..m``: every other solution of the subproblem lies in exactly one
 child.  A child starts from its parent's ``x`` and duals: forbidding ``(r_t, x[r_t])``
 and fixing rows keep the duals feasible (reduced costs stay >= 0), so taking row
-``r_t`` out and re-inserting it along one shortest augmenting path
-(:func:`assocopt.solvers.kernels.sap.augment`) gives the child's optimum, at cost
+``r_t`` out and re-inserting it along one shortest augmenting path that ends at the
+freed column (:func:`assocopt.solvers.kernels.sap.augment`, which reads a rectangular
+matrix as square with implicit zero rows) gives the child's optimum, at cost
 ``parent + path length`` (Miller, Stone & Cox 1997; Crouse 2016).
 
 Lazy evaluation: children go on the heap unsolved, keyed by a lower bound on their
-cost, and are solved only when they reach the top.  The bound: the path must leave row
-``r_t`` by another column and enter the freed column ``x[r_t]`` from another row, two
-different edges of reduced cost >= 0, so the child costs at least ``parent +
-(cheapest other reduced cost in row r_t) + (cheapest other reduced cost in column
-x[r_t])``; a child whose bound is infinite is empty and never made.  Order of the
-partition: the rows with the largest bounds are split first, so that the promising
-children (small bounds, most likely to be expanded next) carry the most fixed rows and
-are the smallest problems.
+cost, and are solved only when they reach the top.  The bound: the path leaves row
+``r_t`` by another column and enters the freed column ``x[r_t]`` from another row (or a
+zero row), two different edges of reduced cost >= 0, so the child costs at least
+``parent + (cheapest other reduced cost in row r_t) + (cheapest other reduced cost
+into column x[r_t])``; a child whose bound is infinite is empty and never made.  Order
+of the partition: the rows with the largest bounds are split first, so that the
+promising children (small bounds, the likeliest to be expanded next) carry the most
+fixed rows and are the smallest problems.
 
 Heap entries ``(key, kind, seq, ...)``: ``kind`` 0 for a solved subproblem (key = its
 cost) before 1 for an unsolved one (key = its bound less a rounding tolerance) at equal
@@ -64,13 +66,12 @@ def _forbid(A, A0, FR, FC, FN, h, on):
 @njit(cache=True)
 def _active_cols(x, fixed, colfixed, cols):
     """The columns not held by a fixed row, into ``cols``; returns their number."""
-    N = x.shape[0]
     colfixed[:] = False
-    for r in range(N):
+    for r in range(x.shape[0]):
         if fixed[r]:
             colfixed[x[r]] = True
     n = 0
-    for j in range(N):
+    for j in range(colfixed.shape[0]):
         if not colfixed[j]:
             cols[n] = j
             n += 1
@@ -82,13 +83,15 @@ def _bounds(A, x, u, v, fixed, P, cols, ncols, base):
     """The free real rows of a solved subproblem and their children's lower bounds
     (see the module docstring), in the order of the partition (largest bound first;
     equal bounds by row index)."""
-    N = A.shape[0]
-    m1 = np.full(N, INF)            # per column: least reduced cost over active rows
-    m2 = np.full(N, INF)            # and the second least, and the row of the least
-    a1 = np.full(N, -1, np.int64)
-    for r in range(N):
+    nr = A.shape[0]
+    m1 = np.full(A.shape[1], INF)   # per column: least reduced cost over active rows,
+    m2 = np.full(A.shape[1], INF)   # the second least, and the row of the least
+    a1 = np.full(A.shape[1], -1, np.int64)
+    active = 0
+    for r in range(nr):
         if fixed[r]:
             continue
+        active += 1
         ur = u[r]
         for t in range(ncols):
             j = cols[t]
@@ -101,6 +104,10 @@ def _bounds(A, x, u, v, fixed, P, cols, ncols, base):
                     a1[j] = r
                 elif rc < m2[j]:
                     m2[j] = rc
+    vmax = -INF                     # zero rows (free columns) hold the largest v
+    if ncols > active:
+        for t in range(ncols):
+            vmax = max(vmax, v[cols[t]])
     rows = np.empty(P, np.int64)
     b = np.empty(P)
     m = 0
@@ -117,6 +124,8 @@ def _bounds(A, x, u, v, fixed, P, cols, ncols, base):
                 if rc < rowmin:
                     rowmin = rc
         colmin = m2[c] if a1[c] == r else m1[c]
+        if vmax > -INF:
+            colmin = min(colmin, vmax - v[c])
         rows[m] = r
         b[m] = INF if rowmin == INF or colmin == INF else \
             base + max(rowmin, 0.0) + max(colmin, 0.0)
@@ -135,7 +144,7 @@ def _cost(A0, x):
 
 @njit(cache=True)
 def murty(A0, P, k, tol):
-    """The ``k`` best assignments of the square ``A0`` (see the module docstring).
+    """The ``k`` best assignments of ``A0`` (see the module docstring).
 
     Returns ``(cols, costs, n, exhausted, solved)``: ``cols[q, :P]`` the columns of
     the real rows in the ``q``-th best (``q < n``), ``costs[q]`` its cost (float sum
@@ -143,29 +152,29 @@ def murty(A0, P, k, tol):
     number of subproblems solved (root included).  ``tol``: subtracted from the lower
     bounds, so that rounding never ranks a child too late.
     """
-    N = A0.shape[0]
+    nr, nc = A0.shape
     A = A0.copy()
     ocap = min(k, 256)
     out_x = np.empty((ocap, P), np.int64)
     out_c = np.empty(ocap)
-    x = np.full(N, -1, np.int64)
-    y = np.full(N, -1, np.int64)
-    u = np.zeros(N)
-    v = np.zeros(N)
+    x = np.full(nr, -1, np.int64)
+    y = np.full(nc, -1, np.int64)
+    u = np.zeros(nr)
+    v = np.zeros(nc)
     if not row_start(A, u) or not lap_warm(A, x, y, u, v):
         return out_x[:0], out_c[:0], 0, True, 1
-    d = np.empty(N)
-    pred = np.empty(N, np.int64)
-    done = np.zeros(N, np.bool_)
-    scanned = np.empty(N, np.int64)
-    cols = np.empty(N, np.int64)
-    colfixed = np.zeros(N, np.bool_)
-    fixed = np.zeros(N, np.bool_)
+    d = np.empty(nc)
+    pred = np.empty(nc, np.int64)
+    done = np.zeros(nc, np.bool_)
+    scanned = np.empty(nc, np.int64)
+    cols = np.empty(nc, np.int64)
+    colfixed = np.zeros(nc, np.bool_)
+    fixed = np.zeros(nr, np.bool_)
     cap = 64
-    SX = np.empty((cap, N), np.int64)      # per solved subproblem (slot): solution,
-    SU = np.empty((cap, N))                # duals, fixed rows, partition order and
-    SV = np.empty((cap, N))                # its length, forbidden chain, cost
-    SF = np.zeros((cap, N), np.bool_)
+    SX = np.empty((cap, nr), np.int64)     # per solved subproblem (slot): solution,
+    SU = np.empty((cap, nr))               # duals, fixed rows, partition order and
+    SV = np.empty((cap, nc))               # its length, forbidden chain, cost
+    SF = np.zeros((cap, nr), np.bool_)
     SO = np.empty((cap, P), np.int64)
     SN = np.zeros(cap, np.int64)
     SH = np.full(cap, -1, np.int64)
@@ -200,13 +209,14 @@ def murty(A0, P, k, tol):
                 fixed[SO[s, q]] = True
             ncols = _active_cols(x, fixed, colfixed, cols)
             y[:] = -1
-            for r in range(N):
+            for r in range(nr):
                 y[x[r]] = r
             i = SO[s, t]
-            y[x[i]] = -1
+            c = x[i]
+            y[c] = -1
             x[i] = -1
             _forbid(A, A0, FR, FC, FN, h, True)
-            delta = augment(A, i, x, y, u, v, cols, ncols, d, pred, done, scanned)
+            delta = augment(A, i, c, x, y, u, v, cols, ncols, d, pred, done, scanned)
             _forbid(A, A0, FR, FC, FN, h, False)
             solved += 1
             if delta == INF:

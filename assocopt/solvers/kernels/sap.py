@@ -8,16 +8,27 @@ row ``i`` (-1: none), ``y[j]`` the row of column ``j`` (-1: free), duals ``u`` (
 entry and ``= 0`` on the pairs of ``x``.  One augmentation (:func:`augment`) takes an
 unassigned row to a free column along the path of least total reduced cost and moves
 the duals so that both conditions still hold; when every row is assigned, the duals
-prove the assignment optimal.  For a rectangular matrix the proof also needs
-``v <= 0``, and ``v[j] = 0`` on free columns: a cold start (``v = 0``) keeps that, since
-only columns on a path ever change (and stay assigned).
+prove the assignment optimal.  For a rectangular matrix the proof also needs the free
+columns to share the largest ``v`` (``v <= 0`` with ``v = 0`` on the free columns, up to
+a constant moved from ``v`` to ``u``): a cold start (``v = 0``) keeps that, since only
+columns on a path change (lowered, and assigned from then on).
 
 Warm starts: any state that satisfies those conditions may be handed in (a partial
-assignment with its duals).  Forbidding the pair of a row (``A[i, x[i]] = inf``) and
-taking the row out keeps the duals feasible, so one augmentation re-solves the matrix
-(square matrices: the freed column has no sign condition).  Rows and columns can be
-taken out of the problem altogether (Murty's fixed pairs) by leaving them out of
-``cols`` and never augmenting those rows: that only removes constraints.
+assignment with its duals).  Rows and columns can be taken out of the problem
+altogether (Murty's fixed pairs) by leaving them out of ``cols`` and never augmenting
+those rows: that only removes constraints.
+
+Re-solving after a row lost its column (Murty's children): forbidding the pair
+(``A[i, x[i]] = inf``) and taking row ``i`` out keeps the reduced costs >= 0, but in a
+rectangular matrix the freed column may have ``v < 0`` and so may not simply stay free.
+The matrix is then read as square, with ``nc - nr`` implicit zero rows holding the free
+columns (the duals above are feasible for it, the zero rows' potentials being minus the
+``v`` of the column each holds, the largest ``v`` of all); the one free column is the
+freed one, and one augmenting path ends there (``sink``).  A path may pass through a
+zero row: reaching a free column at distance ``h`` lets a zero row move from it to any
+column ``j`` at ``h + v[free] - v[j]``; since all free columns share the largest ``v``,
+only the first one reached needs expanding.  Every state this leaves again satisfies
+the conditions above, for the next child.
 """
 
 from __future__ import annotations
@@ -29,37 +40,51 @@ INF = np.inf
 
 
 @njit(cache=True)
-def augment(A, i, x, y, u, v, cols, ncols, d, pred, done, scanned):
+def augment(A, i, sink, x, y, u, v, cols, ncols, d, pred, done, scanned):
     """One shortest augmenting path from the unassigned row ``i`` over the columns
     ``cols[:ncols]``; updates ``x, y, u, v`` in place.
 
+    ``sink < 0``: the path ends at any free column (a cold or partial solve).
+    ``sink >= 0``: it ends at that column, and every other free column counts as held by
+    one of the ``nc - nr`` implicit zero rows that make the matrix square (Murty's
+    re-solve after a row lost its column ``sink``; see the module docstring).
     ``d, pred, done, scanned``: work arrays of length ``nc`` (``done`` all False on
     entry and on return).  Returns the path's length (the rise of the optimum), or
-    ``inf`` when no free column can be reached (nothing is changed then).  Ties go to
-    the lowest column index, preferring a free column: the same path every run.
+    ``inf`` when no path exists (nothing is changed then).  Ties go to the lowest
+    column index, preferring the end of the path: the same path every run.
     """
     for t in range(ncols):
         d[cols[t]] = INF
-    r = i
+    r = i                      # row to relax from: >= 0 real, -1 the zero rows, -2 none
     h = 0.0
+    ur = 0.0
+    vz = 0.0                   # the zero rows' column potential, once reached
+    jz = -1
     nscan = 0
-    sink = -1
     while True:
-        ur = u[r]
-        best = INF
+        best = INF             # relax from row r and pick the nearest column, one pass
         jb = -1
+        if r >= 0:
+            ur = u[r]
         for t in range(ncols):
             j = cols[t]
             if done[j]:
                 continue
-            a = A[r, j]
-            if a < INF:
-                val = h + (a - ur - v[j])
+            if r >= 0:
+                a = A[r, j]
+                if a < INF:
+                    val = h + (a - ur - v[j])
+                    if val < d[j]:
+                        d[j] = val
+                        pred[j] = r
+            elif r == -1:      # reduced cost of a zero row: v[held column] - v[j]
+                val = h + (vz - v[j])
                 if val < d[j]:
                     d[j] = val
-                    pred[j] = r
+                    pred[j] = -2 - jz
             dj = d[j]
-            if dj < best or (dj == best and jb >= 0 and y[jb] >= 0 and y[j] < 0):
+            if dj < best or (dj == best and jb >= 0 and _ends(j, sink, y)
+                             and not _ends(jb, sink, y)):
                 best = dj
                 jb = j
         if jb < 0 or best == INF:
@@ -69,30 +94,47 @@ def augment(A, i, x, y, u, v, cols, ncols, d, pred, done, scanned):
         done[jb] = True
         scanned[nscan] = jb
         nscan += 1
-        if y[jb] < 0:
-            sink = jb
+        if _ends(jb, sink, y):
             break
-        r = y[jb]
         h = best
-    delta = d[sink]
+        if y[jb] >= 0:
+            r = y[jb]
+        elif jz < 0:           # the first column held by a zero row: expand them once
+            r = -1             # (all such columns share the largest v: the others
+            jz = jb            # are dominated)
+            vz = v[jb]
+        else:
+            r = -2
+    delta = d[jb]
     u[i] += delta
-    for t in range(nscan - 1):          # the scanned columns before the sink
+    for t in range(nscan - 1):          # the scanned columns before the end
         j = scanned[t]
         step = delta - d[j]
         v[j] -= step
-        u[y[j]] += step
+        if y[j] >= 0:
+            u[y[j]] += step
     for t in range(nscan):
         done[scanned[t]] = False
-    j = sink
+    j = jb
     while True:
-        r = pred[j]
-        y[j] = r
-        nxt = x[r]
-        x[r] = j
-        if r == i:
-            break
-        j = nxt
+        p = pred[j]
+        if p >= 0:
+            y[j] = p
+            nxt = x[p]
+            x[p] = j
+            if p == i:
+                break
+            j = nxt
+        else:                  # a zero row moves to j from the column it held
+            y[j] = -1
+            j = -2 - p
     return delta
+
+
+@njit(cache=True)
+def _ends(j, sink, y):
+    """Whether a path may end at column ``j``."""
+    return j == sink if sink >= 0 else y[j] < 0
 
 
 @njit(cache=True)
@@ -123,7 +165,7 @@ def lap_warm(A, x, y, u, v):
     scanned = np.empty(nc, np.int64)
     for i in range(nr):
         if x[i] < 0:
-            if augment(A, i, x, y, u, v, cols, nc, d, pred, done, scanned) == INF:
+            if augment(A, i, -1, x, y, u, v, cols, nc, d, pred, done, scanned) == INF:
                 return False
     return True
 
