@@ -171,11 +171,8 @@ def _solutions_dense(problem: AssignmentProblem, cor: np.ndarray) -> list[Soluti
     objs = [math.fsum(v) for v in vals.tolist()]
     slack = d.slack
     out = []
-    for s in range(K):
-        a = int(n_pairs[s])
-        sel = pos[s, a:].copy()
-        t = tup[s, a:2 * a] if slack else tup[s, a:]
-        out.append((objs[s], sel, t.copy()))
+    for s, a in enumerate(n_pairs.tolist()):       # views of per-call arrays
+        out.append((objs[s], pos[s, a:], tup[s, a:2 * a] if slack else tup[s, a:]))
     return _ranked(problem, out)
 
 
@@ -199,7 +196,9 @@ def _ranked(problem: AssignmentProblem, out: list) -> list[Solution]:
     ``selected`` (minimisation sense; flipped for a maximisation problem)."""
     from . import __version__
 
-    out.sort(key=lambda e: (e[0], e[1].tolist()))
+    objs = [e[0] for e in out]
+    if any(a >= b for a, b in zip(objs, objs[1:])):   # ties (or rounding): reorder
+        out.sort(key=lambda e: (e[0], e[1].tolist()))
     sols = []
     sign = -1.0 if problem.maximize else 1.0
     for rank, (obj, sel, tuples) in enumerate(out, 1):
