@@ -116,7 +116,8 @@ def kbest_2d(problem: AssignmentProblem, k: int) -> tuple[list[Solution], bool, 
     finite = np.abs(form.A[np.isfinite(form.A)])
     tol = 1e-9 * max(1.0, float(finite.max()) if finite.size else 1.0)
     k0 = spent()
-    ensure(murty, form.A, form.P, k, tol)
+    if not murty.overloads:        # the one signature (float64 matrix): once a process
+        ensure(murty, form.A, form.P, k, tol)
     k1 = spent()
     X, _, n, exhausted, solved = murty(form.A, form.P, k, tol)
     X = np.where(X < form.n_real_cols, X, -1)

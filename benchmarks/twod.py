@@ -285,6 +285,10 @@ def _us(s: float) -> str:
     return f"{s * 1e6:.1f} us" if s < 1e-3 else f"{s * 1e3:.2f} ms" if s < 1 else f"{s:.2f} s"
 
 
+def _ratio(x: float) -> str:
+    return f"{x:.0f}x" if x >= 10 else f"{x:.1f}x"
+
+
 def render(data: dict) -> str:
     """The Markdown page, from the JSON only."""
     env = data["environment"]
@@ -347,7 +351,7 @@ def render(data: dict) -> str:
         enum = "-" if r["enumerate_s"] is None else _us(r["enumerate_s"])
         lines.append(f"| {r['problem']} | {feas} | {r['k']} | {r['found']} | "
                      f"{r['subproblems']} | {_us(r['kbest_s'])} | {_us(r['generic_s'])} | "
-                     f"{r['generic_s'] / r['kbest_s']:.0f}x | {enum} | "
+                     f"{_ratio(r['generic_s'] / r['kbest_s'])} | {enum} | "
                      f"{'yes' if r['equal'] else 'NO'} |")
     lines += ["", "TCL's `kBest2DAssign` (Tracker Component Library): no published timing "
               "figures were found, so it is not compared here.", "",

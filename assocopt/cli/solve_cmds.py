@@ -71,6 +71,21 @@ def _compile_note(problem: Any, solver: str, relax: str | None, err: TextIO) -> 
     return True
 
 
+def _kbest_note(problem: Any, solver: str, err: TextIO) -> bool:
+    """:func:`_compile_note` for the compiled 2-D ranking of ``--kbest``."""
+    from .. import kbest2d
+
+    if problem.ndim != 2 or solver != "auto" or not kbest2d.available():
+        return False
+    from ..solvers import bnb_kernels
+    from ..solvers.kernels.murty2d import murty
+    if bnb_kernels.cached(murty):
+        return False
+    print("assocopt: compiling the numba kernels (first run only, about 15-30 s; "
+          "cached afterwards) ...", end="", file=err, flush=True)
+    return True
+
+
 def _compile_done(sol: Any, begun: bool, err: TextIO) -> None:
     """One line on stderr with the compilation time, when the solve compiled kernels."""
     if sol is None:              # the solve raised: end the begun line, say no more
@@ -97,8 +112,13 @@ def _cmd_kbest(args: argparse.Namespace, out: TextIO, err: TextIO) -> int:
     if args.kbest < 1:
         raise AssocoptError(f"--kbest must be a positive integer, got {args.kbest}")
     problem = read_instance(args.file, format=args.format, instance=args.instance)
-    _compile_note(problem, args.solver or "auto", None, err)
-    ranked = kbest(problem, args.kbest, args.solver or "auto")
+    solver = args.solver or "auto"
+    begun = _compile_note(problem, solver, None, err) or _kbest_note(problem, solver, err)
+    ranked = None
+    try:
+        ranked = kbest(problem, args.kbest, solver)
+    finally:
+        _compile_done(ranked, begun, err)
     if args.json:
         rec = {"instance": problem.name, "sizes": list(problem.sizes), **ranked.to_dict()}
         print(json.dumps(rec, allow_nan=False), file=out)

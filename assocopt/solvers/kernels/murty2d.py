@@ -49,8 +49,16 @@ INF = np.inf
 
 @njit(cache=True)
 def _grow(a, cap):
-    """``a`` (rows = slots) copied into an array of ``cap`` rows."""
-    b = np.empty((cap,) + a.shape[1:], a.dtype)
+    """The 1-D ``a`` copied into an array of length ``cap``."""
+    b = np.empty(cap, a.dtype)
+    b[:a.shape[0]] = a
+    return b
+
+
+@njit(cache=True)
+def _grow2(a, cap):
+    """The 2-D ``a`` (rows = slots) copied into an array of ``cap`` rows."""
+    b = np.empty((cap, a.shape[1]), a.dtype)
     b[:a.shape[0]] = a
     return b
 
@@ -199,8 +207,9 @@ def murty(A0, P, k, tol):
         if kind == 1:                      # an unsolved child: solve it now
             if nslot == cap:
                 cap *= 2
-                SX, SU, SV, SF = _grow(SX, cap), _grow(SU, cap), _grow(SV, cap), _grow(SF, cap)
-                SO, SN, SH, SC = _grow(SO, cap), _grow(SN, cap), _grow(SH, cap), _grow(SC, cap)
+                SX, SU, SV = _grow2(SX, cap), _grow2(SU, cap), _grow2(SV, cap)
+                SF, SO = _grow2(SF, cap), _grow2(SO, cap)
+                SN, SH, SC = _grow(SN, cap), _grow(SH, cap), _grow(SC, cap)
             x[:] = SX[s]
             u[:] = SU[s]
             v[:] = SV[s]
@@ -239,7 +248,7 @@ def murty(A0, P, k, tol):
             break
         if n == ocap:
             ocap = min(2 * ocap, k)
-            out_x, out_c = _grow(out_x, ocap), _grow(out_c, ocap)
+            out_x, out_c = _grow2(out_x, ocap), _grow(out_c, ocap)
         out_x[n] = SX[s, :P]
         out_c[n] = SC[s]
         n += 1
