@@ -28,6 +28,17 @@ def test_committed_results_agree_with_the_references():
         assert 0.0 <= r["max_abs_error"] <= 1.0 and 0.0 < r["min_mass_covered"] <= 1.0
 
 
+def test_kbest_rows_time_both_paths_on_tracker_sizes():
+    rows = json.loads((ROOT / "docs" / "benchmarks-2d.json").read_text())["kbest"]
+    assert {(r["problem"], r["k"]) for r in rows} >= {("miss 20x20", 100),
+                                                      ("miss 50x50", 100)}
+    for r in rows:
+        assert r["kbest_s"] > 0 and r["generic_s"] > 0 and r["found"] <= r["k"]
+        small = r["feasible"] is not None
+        assert r["reference"] == ("enumeration" if small else "scipy-lsa path")
+        assert (r["enumerate_s"] is not None) == small
+
+
 def test_quick_run_writes_a_consistent_page(tmp_path):
     bench = _bench()
     assert bench.main(["--quick", "--out", str(tmp_path)]) == 0

@@ -1,8 +1,14 @@
 """numba kernels of the ``bnb`` back end, the compiled window search of
-``lagrangian-exact`` and the sparse 2-D LAP (:mod:`.sparse_lap`, imported by
-:mod:`assocopt.solvers.sparse2d`); imported only when one of them runs (importing
-numba costs half a second).  :mod:`assocopt.solvers.bnb_kernels` is the import point
-of the ``bnb`` kernels.
+``lagrangian-exact``, the sparse 2-D LAP (:mod:`.sparse_lap`, imported by
+:mod:`assocopt.solvers.sparse2d`) and the 2-D ranking of :func:`assocopt.kbest`
+(:mod:`.sap`: a warm-startable shortest-augmenting-path LAP on dense matrices,
+:mod:`.murty2d`: Murty's method on it, imported by :mod:`assocopt.kbest2d`); imported
+only when one of them runs (importing numba costs half a second).
+:mod:`assocopt.solvers.bnb_kernels` is the import point of the ``bnb`` kernels.
+
+numba's disk cache does not notice a change in a kernel another file calls: after
+editing ``sap.py``, delete ``__pycache__/murty2d.*.nb[ic]`` (the same holds for
+``driver.py`` and the kernels it calls).
 
 This package file itself imports no numba: it holds the clock of compilation and
 cache loading (:func:`ensure`, :func:`spent`), which :func:`assocopt.solve` reads
