@@ -26,9 +26,12 @@ cost, and are solved only when they reach the top.  The bound: the path leaves r
 zero row), two different edges of reduced cost >= 0, so the child costs at least
 ``parent + (cheapest other reduced cost in row r_t) + (cheapest other reduced cost
 into column x[r_t])``; a child whose bound is infinite is empty and never made.  Order
-of the partition: the rows with the largest bounds are split first, so that the
-promising children (small bounds, the likeliest to be expanded next) carry the most
-fixed rows and are the smallest problems.
+of the partition: the rows with the largest bounds (taken over the parent's free rows
+and columns) are split first, so that the promising children (small bounds, the
+likeliest to be expanded next) carry the most fixed rows and are the smallest problems;
+each child's bound is then tightened over its own free rows and columns (the rows
+split before it, and their columns, are fixed), which in the benchmarks about halves
+to thirds the number of subproblems solved.
 
 Heap entries ``(key, kind, seq, ...)``: ``kind`` 0 for a solved subproblem (key = its
 cost) before 1 for an unsolved one (key = its bound less a rounding tolerance) at equal
@@ -88,9 +91,9 @@ def _active_cols(x, fixed, colfixed, cols):
 
 @njit(cache=True)
 def _bounds(A, x, u, v, fixed, P, cols, ncols, base):
-    """The free real rows of a solved subproblem and their children's lower bounds
-    (see the module docstring), in the order of the partition (largest bound first;
-    equal bounds by row index)."""
+    """The free real rows of a solved subproblem in the order of the partition
+    (largest bound first, equal bounds by row index) and their children's lower
+    bounds, tightened to each child's own fixed rows (see the module docstring)."""
     nr = A.shape[0]
     m1 = np.full(A.shape[1], INF)   # per column: least reduced cost over active rows,
     m2 = np.full(A.shape[1], INF)   # the second least, and the row of the least
@@ -139,7 +142,34 @@ def _bounds(A, x, u, v, fixed, P, cols, ncols, base):
             base + max(rowmin, 0.0) + max(colmin, 0.0)
         m += 1
     order = np.argsort(-b[:m], kind="mergesort")
-    return rows[:m][order], b[:m][order]
+    rows = rows[:m][order]
+    b = b[:m][order]
+    # tighten: child t also has rows[:t] fixed, their columns gone
+    gone_r = fixed.copy()
+    gone_c = np.zeros(A.shape[1], np.bool_)
+    for t in range(m):
+        r = rows[t]
+        if b[t] < INF:
+            c = x[r]
+            ur = u[r]
+            rowmin = INF
+            for q in range(ncols):
+                j = cols[q]
+                if j != c and not gone_c[j] and A[r, j] < INF:
+                    rc = A[r, j] - ur - v[j]
+                    if rc < rowmin:
+                        rowmin = rc
+            colmin = vmax - v[c] if vmax > -INF else INF
+            for q in range(nr):
+                if q != r and not gone_r[q] and A[q, c] < INF:
+                    rc = A[q, c] - u[q] - v[c]
+                    if rc < colmin:
+                        colmin = rc
+            b[t] = INF if rowmin == INF or colmin == INF else \
+                base + max(rowmin, 0.0) + max(colmin, 0.0)
+        gone_r[r] = True
+        gone_c[x[r]] = True
+    return rows, b
 
 
 @njit(cache=True)
