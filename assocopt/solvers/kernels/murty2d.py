@@ -30,8 +30,8 @@ of the partition: the rows with the largest bounds (taken over the parent's free
 and columns) are split first, so that the promising children (small bounds, the
 likeliest to be expanded next) carry the most fixed rows and are the smallest problems;
 each child's bound is then tightened over its own free rows and columns (the rows
-split before it, and their columns, are fixed), which in the benchmarks about halves
-to thirds the number of subproblems solved.
+split before it, and their columns, are fixed), so that fewer children reach the top
+of the heap only to be solved and found dear.
 
 Heap entries ``(key, kind, seq, ...)``: ``kind`` 0 for a solved subproblem (key = its
 cost) before 1 for an unsolved one (key = its bound less a rounding tolerance) at equal
