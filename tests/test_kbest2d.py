@@ -203,3 +203,9 @@ def test_warm_lap_from_a_partial_assignment_equals_scipy(A, data):
     assert lap_warm(A, x, y, u, v)
     assert float(A[np.arange(len(x)), x].sum()) == pytest.approx(_scipy(A), abs=1e-9)
     _assert_certificate(A, x, u, v)
+
+
+def test_times_report_total_and_kernel_preparation_apart():
+    r = kbest(AssignmentProblem.two_d(np.eye(3), 0.5, 0.5), 5)
+    assert set(r.times) <= {"total", "compile", "cache_load"} and r.times["total"] > 0
+    assert r.to_dict()["solver"] == kbest2d.NAME and r.to_dict()["found"] == 5
