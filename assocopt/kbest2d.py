@@ -42,7 +42,7 @@ __all__ = ["available", "lap_form", "kbest_2d", "NAME"]
 #: The name the compiled ranking reports as its solver.
 NAME = "murty2d"
 #: Largest LAP form (entries) ranked by the kernel; larger problems use the generic path.
-MAX_FORM_ENTRIES = 16_000_000
+MAX_FORM_ENTRIES = 8_000_000
 
 
 def available() -> bool:
@@ -115,6 +115,7 @@ def kbest_2d(problem: AssignmentProblem, k: int) -> tuple[list[Solution], bool, 
         return [], True, 1, {}
     finite = np.abs(form.A[np.isfinite(form.A)])
     tol = 1e-9 * max(1.0, float(finite.max()) if finite.size else 1.0)
+    k = min(k, 2**62)              # the kernel counts in int64
     k0 = spent()
     if not murty.overloads:        # the one signature (float64 matrix): once a process
         ensure(murty, form.A, form.P, k, tol)

@@ -67,10 +67,11 @@ def _grow2(a, cap):
 
 
 @njit(cache=True)
-def _forbid(A, A0, FR, FC, FN, h, on):
-    """Set (``on``) or restore the forbidden pairs of the chain starting at ``h``."""
+def _forbid(A, FR, FC, FV, FN, h, on):
+    """Set (``on``) or restore (to the values ``FV``) the forbidden pairs of the chain
+    starting at ``h``."""
     while h >= 0:
-        A[FR[h], FC[h]] = INF if on else A0[FR[h], FC[h]]
+        A[FR[h], FC[h]] = INF if on else FV[h]
         h = FN[h]
 
 
@@ -173,25 +174,25 @@ def _bounds(A, x, u, v, fixed, P, cols, ncols, base):
 
 
 @njit(cache=True)
-def _cost(A0, x):
+def _cost(A, x):
     c = 0.0
     for r in range(x.shape[0]):
-        c += A0[r, x[r]]
+        c += A[r, x[r]]
     return c
 
 
 @njit(cache=True)
-def murty(A0, P, k, tol):
-    """The ``k`` best assignments of ``A0`` (see the module docstring).
+def murty(A, P, k, tol):
+    """The ``k`` best assignments of ``A`` (see the module docstring).
 
     Returns ``(cols, costs, n, exhausted, solved)``: ``cols[q, :P]`` the columns of
     the real rows in the ``q``-th best (``q < n``), ``costs[q]`` its cost (float sum
     in row order), ``exhausted`` True when no further solution exists, ``solved`` the
     number of subproblems solved (root included).  ``tol``: subtracted from the lower
-    bounds, so that rounding never ranks a child too late.
+    bounds, so that rounding never ranks a child too late.  ``A`` is changed during
+    the call (forbidden pairs set to ``inf``) and restored before it returns.
     """
-    nr, nc = A0.shape
-    A = A0.copy()
+    nr, nc = A.shape
     ocap = min(k, 256)
     out_x = np.empty((ocap, P), np.int64)
     out_c = np.empty(ocap)
@@ -221,10 +222,11 @@ def murty(A0, P, k, tol):
     FR = np.empty(fcap, np.int64)          # forbidden pairs, as linked lists
     FC = np.empty(fcap, np.int64)
     FN = np.empty(fcap, np.int64)
+    FV = np.empty(fcap)
     SX[0] = x
     SU[0] = u
     SV[0] = v
-    SC[0] = _cost(A0, x)
+    SC[0] = _cost(A, x)
     nslot = 1
     nf = 0
     seq = 1
@@ -254,9 +256,9 @@ def murty(A0, P, k, tol):
             c = x[i]
             y[c] = -1
             x[i] = -1
-            _forbid(A, A0, FR, FC, FN, h, True)
+            _forbid(A, FR, FC, FV, FN, h, True)
             delta = augment(A, i, c, x, y, u, v, cols, ncols, d, pred, done, scanned)
-            _forbid(A, A0, FR, FC, FN, h, False)
+            _forbid(A, FR, FC, FV, FN, h, False)
             solved += 1
             if delta == INF:
                 continue
@@ -268,7 +270,7 @@ def murty(A0, P, k, tol):
             SV[nslot] = v
             SF[nslot] = fixed
             SH[nslot] = h
-            SC[nslot] = _cost(A0, x)
+            SC[nslot] = _cost(A, x)
             heapq.heappush(heap, (SC[nslot], 0, seq, nslot, -1, -1))
             seq += 1
             nslot += 1
@@ -282,10 +284,10 @@ def murty(A0, P, k, tol):
         out_x[n] = SX[s, :P]
         out_c[n] = SC[s]
         n += 1
-        _forbid(A, A0, FR, FC, FN, SH[s], True)
+        _forbid(A, FR, FC, FV, FN, SH[s], True)
         ncols = _active_cols(SX[s], SF[s], colfixed, cols)
         rows, b = _bounds(A, SX[s], SU[s], SV[s], SF[s], P, cols, ncols, SC[s])
-        _forbid(A, A0, FR, FC, FN, SH[s], False)
+        _forbid(A, FR, FC, FV, FN, SH[s], False)
         m = rows.shape[0]
         SO[s, :m] = rows
         SN[s] = m
@@ -295,8 +297,10 @@ def murty(A0, P, k, tol):
             if nf == fcap:
                 fcap *= 2
                 FR, FC, FN = _grow(FR, fcap), _grow(FC, fcap), _grow(FN, fcap)
+                FV = _grow(FV, fcap)
             FR[nf] = rows[q]
             FC[nf] = SX[s, rows[q]]
+            FV[nf] = A[rows[q], FC[nf]]
             FN[nf] = SH[s]
             heapq.heappush(heap, (b[q] - tol, 1, seq, s, q, nf))
             seq += 1
