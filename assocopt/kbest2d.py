@@ -51,9 +51,10 @@ def available() -> bool:
 
 
 class LapForm(NamedTuple):
-    """A square LAP form (see the module docstring): ``A``, its first ``P`` rows real,
-    ``transposed`` (rows are the problem's columns), ``n_real_cols`` (columns of ``A``
-    below that index are the other side's real indices; the rest stand for misses)."""
+    """A LAP form (see the module docstring): ``A`` (rows <= columns, or infeasible),
+    its first ``P`` rows real, ``transposed`` (rows are the problem's columns),
+    ``n_real_cols`` (columns of ``A`` below that index are the other side's real
+    indices; the rest stand for misses)."""
 
     A: np.ndarray
     P: int
