@@ -238,7 +238,7 @@ def kbest_rows(ks: list[int], quick: bool) -> list[dict]:
             objs = sorted(p.objective_of(s) for s in enumerate_solutions(p, max_nodes=10**8))
             t_enum = time.perf_counter() - t0
         for k in ks if small else [k for k in ks if k >= 10]:
-            t_k, r = _best_time(lambda: kbest(p, k), 1 if quick else 5)
+            t_k, r = _best_time(lambda: kbest(p, k), 1 if quick else 15)
             t_g, g = _best_time(lambda: kbest(p, k, "scipy-lsa"), 1 if quick or not small
                                 else 3)
             got = [float(v) for v in r.objectives]
@@ -337,7 +337,7 @@ def render(data: dict) -> str:
               "the top; *scipy per subproblem*: the generic path, "
               "`kbest(p, k, solver=\"scipy-lsa\")`, one `linear_sum_assignment` per "
               "subproblem solved; *enumerate + sort*: every feasible solution "
-              "(`enumerate_solutions`), sorted.  Times are best of 5 (the generic path: "
+              "(`enumerate_solutions`), sorted.  Times are best of 15 (the generic path: "
               "best of 3, one run on the larger problems), compilation excluded "
               "(cached on disk after the first run).  *same*: the k objectives equal "
               "the k smallest enumerated ones or, where enumeration is out of reach, "
