@@ -98,6 +98,33 @@ def test_compiled_kbest_many_solutions_with_misses(seed):
     _check_ranked(p, 400)
 
 
+@pytest.mark.parametrize("form", ["plain", "dense-rect", "misses", "forced-rows",
+                                  "augmented"])
+def test_compiled_kbest_equals_the_generic_path_on_deeper_trees(form):
+    """8 x 9 problems (too many solutions to enumerate), k = 150, each LAP form:
+    the same objectives as the generic path with scipy per subproblem."""
+    rng = np.random.default_rng(len(form))
+    C = rng.integers(0, 8, (8, 9)).astype(float)
+    C[rng.random(C.shape) < 0.25] = INF
+    rm, cm = rng.integers(0, 6, 8).astype(float), rng.integers(0, 6, 9).astype(float)
+    if form == "plain":
+        p = AssignmentProblem.dense(C[:, :8])
+    elif form == "dense-rect":
+        p = AssignmentProblem.dense(C)
+    elif form == "misses":
+        p = AssignmentProblem.two_d(C, rm, cm)
+    elif form == "forced-rows":
+        p = AssignmentProblem.two_d(C, np.where(np.arange(8) < 4, INF, rm), cm)
+    else:
+        p = AssignmentProblem.two_d(C, np.where(np.arange(8) < 3, INF, rm),
+                                    np.where(np.arange(9) < 3, INF, cm))
+    fast, slow = kbest(p, 150), kbest(p, 150, "scipy-lsa")
+    assert fast.solver == kbest2d.NAME and len(fast) == len(slow) == 150
+    assert fast.objectives == pytest.approx(slow.objectives, abs=1e-9)
+    assert len({tuple(s.selected.tolist()) for s in fast}) == len(fast)
+    assert all(p.violations(s.selected) is None for s in fast)
+
+
 def test_k_beyond_the_count_returns_all_and_says_exhausted():
     p = AssignmentProblem.two_d(np.array([[1.0, INF], [2.0, 3.0]]), [INF, 1.0], 1.0)
     n = sum(1 for _ in enumerate_solutions(p))
