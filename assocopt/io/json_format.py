@@ -18,7 +18,8 @@ import numpy as np
 from ..errors import InvalidProblemError
 from ..problem import AssignmentProblem
 from ..validation import MAX_ABS_COST
-from .common import MAX_JSON_DEPTH, _fail, _json_depth
+from .common import MAX_JSON_DEPTH, _fail, _scan_json
+from .json_bulk import INF_WORDS, bulk_costs, bulk_indices
 
 #: Value of the ``"format"`` key of the project's JSON instance files.
 FORMAT_NAME = "assocopt-instance"
@@ -65,14 +66,20 @@ def _cost_value(v: Any, where: str, path: Path) -> float:
             raise _fail(path, f"{where} is -inf (only +inf, \"inf\", is allowed: forbidden)")
         return f
     if isinstance(v, str):
-        if v.strip().lower() in ("inf", "+inf", "infinity", "+infinity"):
+        if v.strip().lower() in INF_WORDS:
             return math.inf
         raise _fail(path, f"{where} must be a number or \"inf\", found the string {v!r}")
     raise _fail(path, f"{where} must be a number or \"inf\", found {type(v).__name__}")
 
 
-def _cost_array(v: Any, where: str, path: Path, min_ndim: int = 0) -> np.ndarray:
-    """Nested lists of costs -> float64 array, naming the position of any bad entry."""
+def _cost_array(v: Any, where: str, path: Path, min_ndim: int = 0, *,
+                literals: bool = True) -> np.ndarray:
+    """Nested lists of costs -> float64 array, naming the position of any bad entry.
+
+    A well-formed array takes numpy's bulk route (:func:`.json_bulk.bulk_costs`;
+    ``literals=False`` when the file has no ``true``/``false``/``null``); anything
+    else takes the per-entry walk of :func:`_walk_costs`, which gives the message.
+    """
     shape: list[int] = []
     node = v
     while isinstance(node, list):
@@ -85,6 +92,13 @@ def _cost_array(v: Any, where: str, path: Path, min_ndim: int = 0) -> np.ndarray
                           f"(one per axis), found {len(shape)} level(s)")
     if not shape:
         return np.array(_cost_value(v, where, path), dtype=np.float64)
+    arr = bulk_costs(v, shape, literals)
+    return arr if arr is not None else _walk_costs(v, shape, where, path)
+
+
+def _walk_costs(v: list, shape: list[int], where: str, path: Path) -> np.ndarray:
+    """The strict per-entry conversion of nested cost lists of (first-element) ``shape``:
+    raises naming the first ragged list or bad entry."""
 
     def here(idx: list[int]) -> str:
         return where + "".join(f"[{i}]" for i in idx)
@@ -136,6 +150,22 @@ def _int_list(v: Any, where: str, path: Path) -> list[int]:
     return out
 
 
+def _walk_tuples(tuples: list, n_axes: int, path: Path) -> np.ndarray:
+    """The strict per-entry conversion of ``"tuples"``: raises naming the bad entry."""
+    T = [_int_list(t, f"tuples[{k}]", path) for k, t in enumerate(tuples)]
+    for k, t in enumerate(T):
+        if len(t) != n_axes:
+            raise _fail(path, f"tuples[{k}] has {len(t)} indices, expected one per "
+                              f"axis ({n_axes})")
+    return np.array(T) if T else np.zeros((0, n_axes), dtype=np.int64)
+
+
+def _walk_sparse_costs(costs: list, path: Path) -> np.ndarray:
+    """The strict per-entry conversion of a sparse ``"costs"`` list."""
+    return np.array([_cost_value(v, f"costs[{k}]", path) for k, v in enumerate(costs)],
+                    dtype=np.float64)
+
+
 def _parse_float(text: str) -> float:
     value = float(text)
     if math.isinf(value):
@@ -144,13 +174,16 @@ def _parse_float(text: str) -> float:
 
 
 def _read_json(path: Path, text: str) -> AssignmentProblem:
-    depth = _json_depth(text)
-    if depth > MAX_JSON_DEPTH:
-        raise _fail(path, f"invalid JSON: nested {depth} levels deep, more than the "
+    scan = _scan_json(text)
+    if scan.depth > MAX_JSON_DEPTH:
+        raise _fail(path, f"invalid JSON: nested {scan.depth} levels deep, more than the "
                           f"{MAX_JSON_DEPTH} levels an instance file may have")
+    # the parse_float hook (a Python call per float) is only needed when a literal
+    # may overflow: without one, json's own float() gives the same values.
+    hooks = {"parse_float": _parse_float} if scan.big_numbers else {}
     try:
         doc = json.loads(text, object_pairs_hook=_no_duplicates,
-                         parse_constant=_parse_constant, parse_float=_parse_float)
+                         parse_constant=_parse_constant, **hooks)
     except json.JSONDecodeError as exc:
         raise _fail(path, f"invalid JSON: {exc.msg} at line {exc.lineno} column {exc.colno}") from None
     except RecursionError:
@@ -209,15 +242,17 @@ def _read_json(path: Path, text: str) -> AssignmentProblem:
 
     try:
         if kind == "dense":
-            C = _cost_array(doc["costs"], "costs", path, min_ndim=2)
+            C = _cost_array(doc["costs"], "costs", path, min_ndim=2, literals=scan.literals)
             rm = doc.get("row_miss")
             cm = doc.get("col_miss")
             if rm is not None or cm is not None:
                 if C.ndim != 2:
                     raise _fail(path, f"\"row_miss\"/\"col_miss\" need a 2-D cost matrix, "
                                       f"\"costs\" has {C.ndim} axes")
-                rma = None if rm is None else _cost_array(rm, "row_miss", path)
-                cma = None if cm is None else _cost_array(cm, "col_miss", path)
+                rma = None if rm is None else _cost_array(rm, "row_miss", path,
+                                                          literals=scan.literals)
+                cma = None if cm is None else _cost_array(cm, "col_miss", path,
+                                                          literals=scan.literals)
                 p = AssignmentProblem.two_d(C, rma, cma, name=name, optimum=optimum)
             else:
                 p = AssignmentProblem.dense(C, name=name, optimum=optimum)
@@ -227,21 +262,19 @@ def _read_json(path: Path, text: str) -> AssignmentProblem:
             if not isinstance(tuples, list):
                 raise _fail(path, f"\"tuples\" must be a list of index lists, found "
                                   f"{type(tuples).__name__}")
-            T = [_int_list(t, f"tuples[{k}]", path) for k, t in enumerate(tuples)]
-            for k, t in enumerate(T):
-                if len(t) != len(sizes):
-                    raise _fail(path, f"tuples[{k}] has {len(t)} indices, expected one per "
-                                      f"axis ({len(sizes)})")
+            Ta = bulk_indices(tuples, len(sizes), scan.literals)
+            if Ta is None:
+                Ta = _walk_tuples(tuples, len(sizes), path)
             costs = doc["costs"]
             if not isinstance(costs, list):
                 raise _fail(path, f"\"costs\" must be a list of numbers, found "
                                   f"{type(costs).__name__}")
-            if len(costs) != len(T):
+            if len(costs) != len(Ta):
                 raise _fail(path, f"\"costs\" has {len(costs)} entries but \"tuples\" has "
-                                  f"{len(T)}")
-            c = np.array([_cost_value(v, f"costs[{k}]", path) for k, v in enumerate(costs)],
-                         dtype=np.float64)
-            Ta = np.array(T) if T else np.zeros((0, len(sizes)), dtype=np.int64)
+                                  f"{len(Ta)}")
+            c = bulk_costs(costs, (len(costs),), scan.literals)
+            if c is None:
+                c = _walk_sparse_costs(costs, path)
             p = AssignmentProblem.sparse(sizes, Ta, c, name=name, optimum=optimum)
     except InvalidProblemError as exc:
         raise _fail(path, f"invalid problem: {exc}") from exc
