@@ -43,6 +43,18 @@ from .values import _as_cost_array, _as_matrix, _reject_non_finite
 __all__ = ["AssignmentProblem", "OPT_TOL", "kept_axes", "index_label", "MAX_DENSE_CANDIDATES"]
 
 
+def _index_grid(sizes: tuple[int, ...]) -> np.ndarray:
+    """Every real tuple ``(i_1, .., i_N)``, 1-based, in C order: ``(prod(sizes), N)``
+    int64 (what ``np.nonzero`` of an all-true array gives, plus one, without its cost)."""
+    N = len(sizes)
+    out = np.empty(sizes + (N,), dtype=np.int64)
+    for axis, n in enumerate(sizes):
+        shape = [1] * N
+        shape[axis] = n
+        out[..., axis] = np.arange(1, n + 1).reshape(shape)
+    return out.reshape(-1, N)
+
+
 def _freeze(arr: np.ndarray) -> np.ndarray:
     arr.setflags(write=False)
     return arr
@@ -122,9 +134,11 @@ class AssignmentProblem(IndexArithmetic):
                 f"{MAX_DENSE_CANDIDATES}; build a sparse problem of the gated candidates")
         sizes = tuple(int(n) for n in C.shape)
         finite = np.isfinite(C)
-        real = np.stack(np.nonzero(finite), axis=1).astype(np.int64) + 1
-        tuples = [real]
-        costs_list = [C[finite]]
+        if finite.all():        # every tuple is a candidate: a grid, C in C order
+            tuples, costs_list = [_index_grid(sizes)], [C.reshape(-1)]
+        else:
+            tuples = [np.stack(np.nonzero(finite), axis=1).astype(np.int64) + 1]
+            costs_list = [C[finite]]
         n_min = min(sizes)
         # Slack singletons leave the surplus indices of larger axes free.
         for axis, n in enumerate(sizes):
@@ -135,9 +149,10 @@ class AssignmentProblem(IndexArithmetic):
                 costs_list.append(np.zeros(n))
         slack = np.zeros(sum(len(c) for c in costs_list), dtype=bool)
         slack[len(costs_list[0]):] = True
-        return cls._build(sizes, np.concatenate(tuples), np.concatenate(costs_list),
-                          slack, kind="dense", name=name, optimum=optimum,
-                          maximize=maximize)
+        if len(tuples) > 1:
+            tuples, costs_list = [np.concatenate(tuples)], [np.concatenate(costs_list)]
+        return cls._build(sizes, tuples[0], costs_list[0], slack, kind="dense", name=name,
+                          optimum=optimum, maximize=maximize)
 
     @classmethod
     def two_d(cls, costs: ArrayLike, row_miss: ArrayLike | None = None,
