@@ -15,7 +15,7 @@ from typing import Any
 import numpy as np
 
 from ..problem import AssignmentProblem
-from .common import (_INTEGER, _count_error, _cube_root, _dense, _fail, _lines,
+from .common import (_INTEGER, TextFile, _count_error, _cube_root, _dense, _fail,
                      _numbers)
 
 _BS_BLOCK = re.compile(r"^[ \t]*N[ \t]*=[ \t]*(\d+)[ \t]+PROBLEM[ \t]*=[ \t]*(\d+)[ \t]*\r?\n"
@@ -88,19 +88,19 @@ def _read_bs_driver(path: Path, text: str, instance: Any) -> AssignmentProblem:
     tokens = text[start:end].split()
     if len(tokens) != n ** 3:
         raise _count_error(path, n ** 3, len(tokens), f"instance {label}")
-    first_token = len(text[:start].split())
-    values = _numbers(path, text, tokens, first_token)
+    values = _numbers(path, text, tokens, lambda: len(text[:start].split()))
     return _dense(path, values, (n, n, n), f"{path.stem}:{label}", None,
                   "balas-saltzman", instance=label)
 
 
-def _read_bs_split(path: Path, text: str) -> AssignmentProblem:
-    tokens = text.split()
+def _read_bs_split(path: Path, text: str | TextFile) -> AssignmentProblem:
+    src = TextFile.of(text)
+    text, tokens = src.text, src.tokens
     start = 0
     if _cube_root(len(tokens)) is None:
         # optional "3 n" header (d, n)
         if (len(tokens) >= 2 and tokens[0] == "3" and _INTEGER.match(tokens[1])
-                and _lines(text)[0] == tokens[:2]):
+                and src.layout.head[0] == tokens[:2]):
             n = int(tokens[1])
             if len(tokens) - 2 != n ** 3:
                 raise _count_error(path, n ** 3, len(tokens) - 2,

@@ -9,11 +9,12 @@ the file and, where it can, the line of the bad token.
 
 from __future__ import annotations
 
+import functools
 import os
 import re
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Any
+from typing import Any, Callable, NamedTuple
 
 import numpy as np
 
@@ -69,7 +70,7 @@ def _read_text(path: Path) -> str:
         text = data.decode("utf-8-sig")
     except UnicodeDecodeError as exc:
         raise _fail(path, f"not a UTF-8 text file (byte {exc.start}: {exc.reason})") from None
-    if not text.strip():
+    if not text or text.isspace():       # (no stripped copy of a large file)
         raise _fail(path, "the file is empty")
     return text
 
@@ -77,6 +78,48 @@ def _read_text(path: Path) -> str:
 def _lines(text: str) -> list[list[str]]:
     """Token lists of the non-blank lines."""
     return [ln.split() for ln in text.splitlines() if ln.strip()]
+
+
+class Layout(NamedTuple):
+    """The line structure the text formats' detection and readers look at."""
+
+    n_lines: int              #: non-blank lines
+    head: list[list[str]]     #: tokens of the first two non-blank lines
+    one_per_line: bool        #: every non-blank line after the first holds one token
+
+
+class TextFile:
+    """A text instance file split into tokens and lines once, in bulk, for the
+    detection and the reader to share (a per-line split costs far more than the
+    numbers' conversion on files of one cost per line)."""
+
+    def __init__(self, text: str) -> None:
+        self.text = text
+
+    @classmethod
+    def of(cls, text: "str | TextFile") -> "TextFile":
+        return text if isinstance(text, TextFile) else cls(text)
+
+    @functools.cached_property
+    def tokens(self) -> list[str]:
+        """``text.split()``: every token, in order."""
+        return self.text.split()
+
+    @functools.cached_property
+    def layout(self) -> Layout:
+        """:class:`Layout` from C-level passes (line breaks are whitespace, so the
+        tokens of the non-blank lines after the first are one each exactly when they
+        number as many as those lines)."""
+        lines = self.text.splitlines()
+        n = len(lines) - lines.count("") - sum(map(str.isspace, lines))
+        head: list[list[str]] = []
+        for line in lines:
+            if len(head) == 2:
+                break
+            if words := line.split():
+                head.append(words)
+        one = not head or len(self.tokens) - len(head[0]) == n - 1
+        return Layout(n, head, one)
 
 
 def _locate_token(text: str, k: int) -> int:
@@ -90,34 +133,42 @@ def _locate_token(text: str, k: int) -> int:
     return -1
 
 
-def _numbers(path: Path, text: str, tokens: list[str], start_token: int = 0) -> np.ndarray:
+def _floats(tokens: list[str]) -> np.ndarray | None:
+    """The tokens as float64 when every one is a finite number, else None.
+
+    Python's ``float()`` over the list (the syntax numpy's str -> float cast accepts,
+    at several times its speed).
+    """
+    try:
+        values = np.fromiter(map(float, tokens), dtype=np.float64, count=len(tokens))
+    except ValueError:
+        return None
+    return values if np.isfinite(values).all() else None
+
+
+def _numbers(path: Path, text: str, tokens: list[str],
+             start_token: int | Callable[[], int] = 0) -> np.ndarray:
     """Parse cost tokens as float64, naming the first bad token and its line.
 
     ``start_token`` is the position of ``tokens[0]`` in the whole file (for the line
-    number in messages).  Integers and decimal numbers are accepted; ``nan``/``inf``
+    number in messages), or a function computing it (called only on an error).  Integers and decimal numbers are accepted; ``nan``/``inf``
     spelled out are not numbers here.
     """
-    try:
-        values = np.array(tokens, dtype=np.str_).astype(np.float64)
-        ok = bool(np.isfinite(values).all())
-    except ValueError:
-        ok = False
-    if ok:
+    values = _floats(tokens)
+    if values is not None:
         return values
     for k, tok in enumerate(tokens):
         if not _NUMBER.match(tok):
-            line = _locate_token(text, start_token + k)
+            start = start_token() if callable(start_token) else start_token
+            line = _locate_token(text, start + k)
             raise _fail(path, f"non-numeric token {tok!r} on line {line}")
     raise _fail(path, "costs could not be parsed as numbers")  # pragma: no cover
 
 
 def _first_non_number(tokens: list[str]) -> int | None:
     """Position of the first token that is not a plain (finite) number, or None."""
-    try:
-        if np.isfinite(np.array(tokens, dtype=np.str_).astype(np.float64)).all():
-            return None
-    except ValueError:
-        pass
+    if _floats(tokens) is not None:
+        return None
     return next((k for k, t in enumerate(tokens) if not _NUMBER.match(t)), None)
 
 

@@ -16,7 +16,7 @@ from typing import Any
 from ..errors import InstanceFormatError
 from ..problem import AssignmentProblem
 from .balas_saltzman import _BS_BLOCK, _read_bs_driver, _read_bs_split
-from .common import (_INTEGER, _cube_root, _fail, _first_non_number, _lines,
+from .common import (_INTEGER, TextFile, _cube_root, _fail, _first_non_number,
                      _locate_token, _read_text)
 from .grundel import _MAX_D, _read_grundel
 from .json_format import _read_json
@@ -35,17 +35,17 @@ def _looks_grundel(lines: list[list[str]]) -> bool:
             and all(_INTEGER.match(t) and int(t) > 0 for t in lines[1]))
 
 
-def _matches(text: str) -> tuple[dict[str, tuple[bool, int, bool]], str]:
+def _matches(text: str | TextFile) -> tuple[dict[str, tuple[bool, int, bool]], str]:
     """Which public text formats fit the file.
 
     Returns ``{format: (count_fits, expected_count, strong)}`` for every format whose
     layout fits (``count_fits`` False: a damaged file of that format; ``strong``: the
     layout alone is distinctive), and a short description of what was seen.
     """
-    tokens = text.split()
-    lines = _lines(text)
-    L = len(tokens)
-    seen = (f"{len(lines)} non-blank lines, {L} numbers, first line "
+    src = TextFile.of(text)
+    n_lines, lines, one_per_line = src.layout      # lines: the first two only
+    L = len(src.tokens)
+    seen = (f"{n_lines} non-blank lines, {L} numbers, first line "
             f"{' '.join(lines[0][:6])[:60]!r}")
     found: dict[str, tuple[bool, int, bool]] = {}
     # Grundel: "d" / "n1 .. nd" / costs; a square header "n n n" is distinctive
@@ -55,7 +55,6 @@ def _matches(text: str) -> tuple[dict[str, tuple[bool, int, bool]], str]:
         expected = math.prod(sizes)
         found["grundel"] = (L - 1 - d == expected, expected, len(set(sizes)) == 1)
     # Balas-Saltzman split: n^3 numbers (one per line), or a "3 n" header first
-    one_per_line = all(len(ln) == 1 for ln in lines[1:])
     if one_per_line and len(lines[0]) == 2 and lines[0][0] == "3" \
             and _INTEGER.match(lines[0][1]):
         n = int(lines[0][1])
@@ -67,7 +66,7 @@ def _matches(text: str) -> tuple[dict[str, tuple[bool, int, bool]], str]:
     if len(lines[0]) == 1 and _INTEGER.match(lines[0][0]) and int(lines[0][0]) > 0:
         n = int(lines[0][0])
         exact = L - 1 == n * n
-        if exact or not one_per_line or len(lines) < 3:
+        if exact or not one_per_line or n_lines < 3:
             found["orlib"] = (exact, n * n, False)
     if not found and L >= 8 and _cube_root(L) is not None:
         # n**3 numbers laid out otherwise than one per line
@@ -81,17 +80,21 @@ def detect_format(path: str | os.PathLike[str], text: str | None = None) -> str:
     Raises :class:`InstanceFormatError` when the content fits no format, or several.
     """
     path = Path(path)
-    if text is None:
-        text = _read_text(path)
+    return _detect(path, TextFile(_read_text(path) if text is None else text))
+
+
+def _detect(path: Path, src: TextFile) -> str:
+    text = src.text
     head = text.lstrip()
     if head.startswith(("{", "[")):
         return "assocopt"
     if path.suffix.lower() == ".json":
         raise _fail(path, f"invalid assocopt instance: expected a JSON object at the top "
                           f"level, found {head[:40].split(chr(10))[0]!r}")
-    if _BS_BLOCK.search(text) or "AP3 Test Driver" in text[:2000]:
+    # ("PROBLEM" first: a substring search is far cheaper than the regex)
+    if ("PROBLEM" in text and _BS_BLOCK.search(text)) or "AP3 Test Driver" in text[:2000]:
         return "balas-saltzman"
-    found, seen = _matches(text)
+    found, seen = _matches(src)
     hint = _name_hint(path)
     exact = [f for f, (ok, _, _) in found.items() if ok]
     if len(exact) == 1:
@@ -109,7 +112,7 @@ def detect_format(path: str | os.PathLike[str], text: str | None = None) -> str:
         return next(iter(found))
     if hint in found:
         return hint
-    tokens = text.split()
+    tokens = src.tokens
     bad = _first_non_number(tokens)
     if bad is not None:
         raise _fail(path, f"unknown format: non-numeric token {tokens[bad][:40]!r} on line "
@@ -173,17 +176,17 @@ def read_instance(path: str | os.PathLike[str], *, format: str = "auto",
         raise InstanceFormatError(f"unknown format {format!r}; valid: {', '.join(FORMATS)}")
     if os.path.isdir(path):
         raise _fail(path, "is a directory, not an instance file")
-    text = _read_text(path)
-    fmt = detect_format(path, text) if format == "auto" else format
+    src = TextFile(_read_text(path))
+    fmt = _detect(path, src) if format == "auto" else format
     if instance is not None and fmt != "balas-saltzman":
         raise _fail(path, f"an instance was chosen ({instance!r}) but the {fmt} format holds "
                           "one instance per file")
     if fmt == "assocopt":
-        return _read_json(path, text)
+        return _read_json(path, src.text)
     if fmt == "balas-saltzman":
-        return _read_bs_driver(path, text, instance)
+        return _read_bs_driver(path, src.text, instance)
     if fmt == "grundel":
-        return _read_grundel(path, text)
+        return _read_grundel(path, src)
     if fmt == "balas-saltzman-split":
-        return _read_bs_split(path, text)
-    return _read_orlib(path, text)
+        return _read_bs_split(path, src)
+    return _read_orlib(path, src)

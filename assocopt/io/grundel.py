@@ -12,15 +12,17 @@ import re
 from pathlib import Path
 
 from ..problem import AssignmentProblem
-from .common import (_NUMBER, _count_error, _dense, _fail, _header_int, _lines,
+from .common import (_NUMBER, TextFile, _count_error, _dense, _fail, _header_int,
                      _listed_optimum, _numbers)
 
 #: Largest dimension count accepted in a Grundel header.
 _MAX_D = 16
 
 
-def _read_grundel(path: Path, text: str) -> AssignmentProblem:
-    lines = _lines(text)
+def _read_grundel(path: Path, text: str | TextFile) -> AssignmentProblem:
+    src = TextFile.of(text)
+    text = src.text
+    lines = src.layout.head
     if len(lines) < 2:
         raise _fail(path, "Grundel format needs a line 'd' and a line with the d sizes")
     if len(lines[0]) != 1:
@@ -28,7 +30,7 @@ def _read_grundel(path: Path, text: str) -> AssignmentProblem:
     d = _header_int(path, lines[0][0], "d (line 1)")
     if not 2 <= d <= _MAX_D:
         raise _fail(path, f"Grundel format: d = {d} on line 1 is not in 2..{_MAX_D}")
-    tokens = text.split()
+    tokens = src.tokens
     if len(tokens) < 1 + d:
         raise _fail(path, f"Grundel format: line 2 must give {d} sizes")
     sizes = tuple(_header_int(path, t, "a size (line 2)") for t in tokens[1:1 + d])

@@ -9,11 +9,13 @@ from __future__ import annotations
 from pathlib import Path
 
 from ..problem import AssignmentProblem
-from .common import _count_error, _dense, _fail, _header_int, _listed_optimum, _numbers
+from .common import (TextFile, _count_error, _dense, _fail, _header_int, _listed_optimum,
+                     _numbers)
 
 
-def _read_orlib(path: Path, text: str) -> AssignmentProblem:
-    tokens = text.split()
+def _read_orlib(path: Path, text: str | TextFile) -> AssignmentProblem:
+    src = TextFile.of(text)
+    text, tokens = src.text, src.tokens
     n = _header_int(path, tokens[0], "n (the first number)")
     if n < 1:
         raise _fail(path, f"OR-Library format: n = {n} must be positive")
