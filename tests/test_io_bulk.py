@@ -33,7 +33,7 @@ PATH = Path("x.json")
 def strict_only():
     """The reader as it was before the bulk routes: strict parse, per-entry walks."""
     def strict_scan(text):
-        return common.JsonScan(_scan_json(text).depth, True, True)
+        return common.JsonScan(_scan_json(text).depth, True, True, True)
     with mock.patch.object(json_format, "_scan_json", strict_scan), \
             mock.patch.object(json_format, "bulk_costs", lambda *a: None), \
             mock.patch.object(json_format, "bulk_indices", lambda *a: None):
@@ -196,6 +196,24 @@ def test_bad_entries_among_floats_keep_their_message(costs, msg):
         assert re.search(msg, message), message
 
 
+GOOD = st.one_of(st.integers(-10 ** 6, 10 ** 6), st.floats(-1e6, 1e6, allow_nan=False),
+                 st.sampled_from([math.inf, "inf", " +Infinity", "INF"]))
+
+
+@given(st.lists(st.integers(1, 3), min_size=1, max_size=3).flatmap(
+    lambda shape: st.tuples(st.just(shape), st.lists(GOOD, min_size=math.prod(shape),
+                                                     max_size=math.prod(shape)))))
+def test_bulk_tiers_agree_with_the_walk(case):
+    """Every route of bulk_costs gives the walk's array on well-formed entries
+    (``strings`` is only a hint: a wrong False costs time, never a wrong answer)."""
+    shape, flat = case
+    nested = np.array(flat, dtype=object).reshape(shape).tolist()
+    want = json_format._walk_costs(nested, shape, "costs", PATH)
+    for literals in (False, True):
+        for strings in (False, True):
+            np.testing.assert_array_equal(bulk_costs(nested, shape, literals, strings), want)
+
+
 def test_numpy_would_turn_a_bool_into_one():
     """The trap the bulk route must avoid: numpy converts True silently."""
     assert np.array([1.0, True]).dtype == np.float64
@@ -227,7 +245,8 @@ def test_depth_cap_is_kept(tmp_path):
     ('[[{"x": [null]}]]', 4, True, False),
 ])
 def test_json_scan(text, depth, literals, big):
-    assert _scan_json(text) == common.JsonScan(depth, literals, big)
+    scan = _scan_json(text)
+    assert (scan.depth, scan.literals, scan.big_numbers) == (depth, literals, big)
 
 
 @given(st.text(st.sampled_from("0123456789eE+-.[]{} ,\"tn"), max_size=60))

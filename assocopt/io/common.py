@@ -220,6 +220,7 @@ _BRACKETS = b"[]{}"
 _NOT_BRACKETS = bytes(c for c in range(256) if c not in _BRACKETS)
 #: ``[``/``{`` -> +1 and ``]``/``}`` -> -1 (as int8) for the bracket-only bytes.
 _BRACKET_STEP = bytes.maketrans(_BRACKETS, bytes([1, 255, 1, 255]))
+_INF_STRING = re.compile(r'"\s*\+?(?i:inf)')
 _NOT_LETTERS = bytes(c for c in range(256) if not chr(c).isalpha() or c > 127)
 #: Longest run of integer-part digits a number literal may have and still be proven
 #: finite when its exponent has at most two digits (10**200 * 10**99 < 1.8e308).
@@ -234,12 +235,16 @@ class JsonScan:
     or ``null`` may occur (``False`` proves no bool or None anywhere in the
     document).  ``big_numbers``: a number literal may overflow a float (``False``
     proves every literal parses to a finite float, so ``json`` needs no
-    ``parse_float`` hook to catch ``1e999``).  ``True`` answers may be false alarms.
+    ``parse_float`` hook to catch ``1e999``).  ``inf_strings``: a string such as
+    ``"inf"`` may occur (only a hint for speed: a numeric numpy conversion of an
+    array holding strings is bound to fail, slowly).  ``True`` answers may be false
+    alarms.
     """
 
     depth: int
     literals: bool
     big_numbers: bool
+    inf_strings: bool = True
 
 
 def _scan_json(text: str) -> JsonScan:
@@ -250,7 +255,8 @@ def _scan_json(text: str) -> JsonScan:
     depth = int(np.cumsum(steps, dtype=np.int64).max(initial=0))
     letters = bare.translate(None, _NOT_LETTERS)
     literals = any(word in letters for word in (b"true", b"false", b"null"))
-    return JsonScan(depth, literals, _may_overflow(bare))
+    return JsonScan(depth, literals, _may_overflow(bare),
+                    _INF_STRING.search(text) is not None)
 
 
 def _shape_char(c: int) -> str:

@@ -13,7 +13,9 @@ stays the walk's.
 ``literals`` is :attr:`.common.JsonScan.literals` of the whole file: ``False``
 proves there is no ``true``/``false``/``null`` anywhere, so a numeric numpy
 array cannot hide a bool (numpy turns ``[1.0, True]`` into ``[1.0, 1.0]``).
-With ``literals=True`` the entries' types are checked instead.
+With ``literals=True`` the entries' types are checked instead (as they are when
+``strings``, :attr:`.common.JsonScan.inf_strings`, says ``"inf"`` entries may
+occur: numpy would turn the whole array into text first).
 """
 
 from __future__ import annotations
@@ -81,14 +83,15 @@ def _in_range(arr: np.ndarray) -> bool:
     return False
 
 
-def bulk_costs(v: list, shape: Sequence[int], literals: bool) -> np.ndarray | None:
+def bulk_costs(v: list, shape: Sequence[int], literals: bool,
+               strings: bool = True) -> np.ndarray | None:
     """Nested lists of costs as float64 of ``shape``, or None when the walk must decide.
 
     Accepts ints and floats (``+inf`` included) and the strings of
     :data:`INF_WORDS`, with no NaN, ``-inf`` or finite value beyond ``MAX_ABS_COST``.
     """
     shape = tuple(shape)
-    if not literals:
+    if not literals and not strings:
         a = _numeric(v, shape)
         if a is not None:
             a = a.astype(np.float64, copy=False)

@@ -18,7 +18,7 @@ import numpy as np
 from ..errors import InvalidProblemError
 from ..problem import AssignmentProblem
 from ..validation import MAX_ABS_COST
-from .common import MAX_JSON_DEPTH, _fail, _scan_json
+from .common import MAX_JSON_DEPTH, JsonScan, _fail, _scan_json
 from .json_bulk import INF_WORDS, bulk_costs, bulk_indices
 
 #: Value of the ``"format"`` key of the project's JSON instance files.
@@ -73,12 +73,12 @@ def _cost_value(v: Any, where: str, path: Path) -> float:
 
 
 def _cost_array(v: Any, where: str, path: Path, min_ndim: int = 0, *,
-                literals: bool = True) -> np.ndarray:
+                scan: JsonScan | None = None) -> np.ndarray:
     """Nested lists of costs -> float64 array, naming the position of any bad entry.
 
-    A well-formed array takes numpy's bulk route (:func:`.json_bulk.bulk_costs`;
-    ``literals=False`` when the file has no ``true``/``false``/``null``); anything
-    else takes the per-entry walk of :func:`_walk_costs`, which gives the message.
+    A well-formed array takes numpy's bulk route (:func:`.json_bulk.bulk_costs`,
+    helped by what ``scan`` of the whole file proved); anything else takes the
+    per-entry walk of :func:`_walk_costs`, which gives the message.
     """
     shape: list[int] = []
     node = v
@@ -92,7 +92,8 @@ def _cost_array(v: Any, where: str, path: Path, min_ndim: int = 0, *,
                           f"(one per axis), found {len(shape)} level(s)")
     if not shape:
         return np.array(_cost_value(v, where, path), dtype=np.float64)
-    arr = bulk_costs(v, shape, literals)
+    arr = (bulk_costs(v, shape, True) if scan is None else
+           bulk_costs(v, shape, scan.literals, scan.inf_strings))
     return arr if arr is not None else _walk_costs(v, shape, where, path)
 
 
@@ -242,17 +243,15 @@ def _read_json(path: Path, text: str) -> AssignmentProblem:
 
     try:
         if kind == "dense":
-            C = _cost_array(doc["costs"], "costs", path, min_ndim=2, literals=scan.literals)
+            C = _cost_array(doc["costs"], "costs", path, min_ndim=2, scan=scan)
             rm = doc.get("row_miss")
             cm = doc.get("col_miss")
             if rm is not None or cm is not None:
                 if C.ndim != 2:
                     raise _fail(path, f"\"row_miss\"/\"col_miss\" need a 2-D cost matrix, "
                                       f"\"costs\" has {C.ndim} axes")
-                rma = None if rm is None else _cost_array(rm, "row_miss", path,
-                                                          literals=scan.literals)
-                cma = None if cm is None else _cost_array(cm, "col_miss", path,
-                                                          literals=scan.literals)
+                rma = None if rm is None else _cost_array(rm, "row_miss", path, scan=scan)
+                cma = None if cm is None else _cost_array(cm, "col_miss", path, scan=scan)
                 p = AssignmentProblem.two_d(C, rma, cma, name=name, optimum=optimum)
             else:
                 p = AssignmentProblem.dense(C, name=name, optimum=optimum)
@@ -272,7 +271,7 @@ def _read_json(path: Path, text: str) -> AssignmentProblem:
             if len(costs) != len(Ta):
                 raise _fail(path, f"\"costs\" has {len(costs)} entries but \"tuples\" has "
                                   f"{len(Ta)}")
-            c = bulk_costs(costs, (len(costs),), scan.literals)
+            c = bulk_costs(costs, (len(costs),), scan.literals, scan.inf_strings)
             if c is None:
                 c = _walk_sparse_costs(costs, path)
             p = AssignmentProblem.sparse(sizes, Ta, c, name=name, optimum=optimum)
