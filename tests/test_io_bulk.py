@@ -22,8 +22,9 @@ from hypothesis import given, strategies as st
 
 from assocopt import AssignmentProblem
 from assocopt.errors import InstanceFormatError
-from assocopt.io import common, json_format, read_instance, write_instance
-from assocopt.io.common import TextFile, _floats, _lines, _scan_json
+from assocopt.io import json_format, json_scan, read_instance, write_instance
+from assocopt.io.common import TextFile, _floats, _lines
+from assocopt.io.json_scan import scan_json
 from assocopt.io.json_bulk import bulk_costs
 
 PATH = Path("x.json")
@@ -33,8 +34,8 @@ PATH = Path("x.json")
 def strict_only():
     """The reader as it was before the bulk routes: strict parse, per-entry walks."""
     def strict_scan(text):
-        return common.JsonScan(_scan_json(text).depth, True, True, True)
-    with mock.patch.object(json_format, "_scan_json", strict_scan), \
+        return json_scan.JsonScan(scan_json(text).depth, True, True, True)
+    with mock.patch.object(json_format, "scan_json", strict_scan), \
             mock.patch.object(json_format, "bulk_costs", lambda *a: None), \
             mock.patch.object(json_format, "bulk_indices", lambda *a: None):
         yield
@@ -245,7 +246,7 @@ def test_depth_cap_is_kept(tmp_path):
     ('[[{"x": [null]}]]', 4, True, False),
 ])
 def test_json_scan(text, depth, literals, big):
-    scan = _scan_json(text)
+    scan = scan_json(text)
     assert (scan.depth, scan.literals, scan.big_numbers) == (depth, literals, big)
 
 
@@ -254,13 +255,21 @@ def test_scan_proves_what_it_claims(text):
     """``big_numbers=False`` proves no literal overflows: every maximal number-like run
     outside strings then parses to a finite float; ``literals=False`` proves none of
     true/false/null is present outside strings."""
-    scan = _scan_json(text)
-    bare = common._JSON_STRING.sub('""', text)
+    scan = scan_json(text)
+    bare = json_scan._JSON_STRING.sub('""', text)
     if not scan.big_numbers:
         for lit in re.findall(r"-?\d+(?:\.\d+)?(?:[eE][-+]?\d+)?", bare):
             assert math.isfinite(float(lit))
     if not scan.literals:
         assert not any(w in bare for w in ("true", "false", "null"))
+
+
+@given(st.text(st.sampled_from('"[]{}ab\\ 1e'), max_size=40))
+def test_string_blanking_equals_the_regex(text):
+    """The split at quotes (no backslash, every string closed) blanks exactly what
+    the escape-aware regex blanks."""
+    bare, _ = json_scan._blank_strings(text)
+    assert bare == json_scan._JSON_STRING.sub('""', text).encode()
 
 
 # ------------------------------------------------------------ text formats

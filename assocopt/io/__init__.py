@@ -30,12 +30,17 @@ other code uses (and every name the former single-module ``assocopt/io.py`` had)
 so ``from assocopt.io import X`` works as before:
 
 :mod:`.common`
-    ``_fail`` and the text / number parsing helpers shared by every reader.
+    ``_fail`` and the text / number parsing helpers shared by every reader
+    (``TextFile``: a text file's tokens and line layout, computed once).
 :mod:`.grundel`, :mod:`.balas_saltzman`, :mod:`.orlib`
     Readers of the public benchmark formats.
 :mod:`.json_format`
     The JSON v1 format: reader, :func:`instance_to_json`, ``FORMAT_NAME``,
     ``FORMAT_VERSION``.
+:mod:`.json_scan`, :mod:`.json_bulk`
+    The JSON reader's fast route: one pass over the text before parsing, and the
+    bulk conversion of the parsed arrays (the strict per-entry walks stay the
+    fallback that names a bad entry).
 :mod:`.detect`
     :data:`FORMATS`, :func:`detect_format` and :func:`read_instance`.
 :mod:`.mps_lp`

@@ -12,7 +12,6 @@ from __future__ import annotations
 import functools
 import os
 import re
-from dataclasses import dataclass
 from pathlib import Path
 from typing import Any, Callable, NamedTuple
 
@@ -213,73 +212,3 @@ def _cube_root(m: int) -> int | None:
         if c > 0 and c ** 3 == m:
             return c
     return None
-
-
-_JSON_STRING = re.compile(r'"(?:[^"\\]|\\.)*"')
-_BRACKETS = b"[]{}"
-_NOT_BRACKETS = bytes(c for c in range(256) if c not in _BRACKETS)
-#: ``[``/``{`` -> +1 and ``]``/``}`` -> -1 (as int8) for the bracket-only bytes.
-_BRACKET_STEP = bytes.maketrans(_BRACKETS, bytes([1, 255, 1, 255]))
-_INF_STRING = re.compile(r'"\s*\+?(?i:inf)')
-_NOT_LETTERS = bytes(c for c in range(256) if not chr(c).isalpha() or c > 127)
-#: Longest run of integer-part digits a number literal may have and still be proven
-#: finite when its exponent has at most two digits (10**200 * 10**99 < 1.8e308).
-_SAFE_DIGITS = 200
-
-
-@dataclass(frozen=True)
-class JsonScan:
-    """What one bulk pass over JSON text (strings blanked out) proves about it.
-
-    ``depth``: deepest nesting of ``[``/``{``.  ``literals``: a ``true``, ``false``
-    or ``null`` may occur (``False`` proves no bool or None anywhere in the
-    document).  ``big_numbers``: a number literal may overflow a float (``False``
-    proves every literal parses to a finite float, so ``json`` needs no
-    ``parse_float`` hook to catch ``1e999``).  ``inf_strings``: a string such as
-    ``"inf"`` may occur (only a hint for speed: a numeric numpy conversion of an
-    array holding strings is bound to fail, slowly).  ``True`` answers may be false
-    alarms.
-    """
-
-    depth: int
-    literals: bool
-    big_numbers: bool
-    inf_strings: bool = True
-
-
-def _scan_json(text: str) -> JsonScan:
-    """One bulk pass over JSON text (no recursion, no per-character Python)."""
-    bare = _JSON_STRING.sub('""', text).encode("utf-8", "replace")
-    steps = np.frombuffer(bare.translate(None, _NOT_BRACKETS).translate(_BRACKET_STEP),
-                          dtype=np.int8)
-    depth = int(np.cumsum(steps, dtype=np.int64).max(initial=0))
-    letters = bare.translate(None, _NOT_LETTERS)
-    literals = any(word in letters for word in (b"true", b"false", b"null"))
-    return JsonScan(depth, literals, _may_overflow(bare),
-                    _INF_STRING.search(text) is not None)
-
-
-def _shape_char(c: int) -> str:
-    ch = chr(c)
-    return "0" if "0" <= ch <= "9" else "e" if ch in "eE" else " "
-
-
-#: Digits -> ``0``, ``e``/``E`` -> ``e``, every other byte -> space (signs are deleted).
-_NUMBER_SHAPE = "".join(map(_shape_char, range(256))).encode("latin-1")
-
-
-def _may_overflow(bare: bytes) -> bool:
-    """Whether a number literal in ``bare`` may be too large for a float: an exponent
-    of three or more digits, or a run of at least :data:`_SAFE_DIGITS` digits."""
-    shape = bare.translate(_NUMBER_SHAPE, b"+-") + b"   "
-    if b"0" * _SAFE_DIGITS in shape:
-        return True
-    b = np.frombuffer(shape, dtype=np.uint8)
-    e = np.flatnonzero(b[:-3] == ord("e"))
-    zero = ord("0")
-    return bool(((b[e + 1] == zero) & (b[e + 2] == zero) & (b[e + 3] == zero)).any())
-
-
-def _json_depth(text: str) -> int:
-    """Deepest nesting of ``[``/``{`` in JSON text (strings ignored), without recursion."""
-    return _scan_json(text).depth

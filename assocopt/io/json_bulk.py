@@ -10,11 +10,11 @@ other than ``"inf"``, NaN, ``-inf``, a number beyond ``1e300``...) they return
 few odd inputs it accepts, returns the same array).  Every message therefore
 stays the walk's.
 
-``literals`` is :attr:`.common.JsonScan.literals` of the whole file: ``False``
+``literals`` is :attr:`.json_scan.JsonScan.literals` of the whole file: ``False``
 proves there is no ``true``/``false``/``null`` anywhere, so a numeric numpy
 array cannot hide a bool (numpy turns ``[1.0, True]`` into ``[1.0, 1.0]``).
 With ``literals=True`` the entries' types are checked instead (as they are when
-``strings``, :attr:`.common.JsonScan.inf_strings`, says ``"inf"`` entries may
+``strings``, :attr:`.json_scan.JsonScan.inf_strings`, says ``"inf"`` entries may
 occur: numpy would turn the whole array into text first).
 """
 

@@ -18,8 +18,9 @@ import numpy as np
 from ..errors import InvalidProblemError
 from ..problem import AssignmentProblem
 from ..validation import MAX_ABS_COST
-from .common import MAX_JSON_DEPTH, JsonScan, _fail, _scan_json
+from .common import MAX_JSON_DEPTH, _fail
 from .json_bulk import INF_WORDS, bulk_costs, bulk_indices
+from .json_scan import JsonScan, scan_json
 
 #: Value of the ``"format"`` key of the project's JSON instance files.
 FORMAT_NAME = "assocopt-instance"
@@ -175,7 +176,7 @@ def _parse_float(text: str) -> float:
 
 
 def _read_json(path: Path, text: str) -> AssignmentProblem:
-    scan = _scan_json(text)
+    scan = scan_json(text)
     if scan.depth > MAX_JSON_DEPTH:
         raise _fail(path, f"invalid JSON: nested {scan.depth} levels deep, more than the "
                           f"{MAX_JSON_DEPTH} levels an instance file may have")
