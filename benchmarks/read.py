@@ -166,8 +166,8 @@ def measure(rounds: int, quick: bool, before: Path | None,
             r["floor_s"] = round(best_of(lambda: floor(r["path"], r["format"]), rounds), 4)
             r["read_s"] = round(now[k], 4)
             r["before_s"] = None if old is None else round(old[k], 4)
-            r["ratio_to_floor"] = round(now[k] / r["floor_s"], 2)
-            r["speedup"] = None if old is None else round(old[k] / now[k], 1)
+            r["ratio_to_floor"] = round(r["read_s"] / r["floor_s"], 2)
+            r["speedup"] = None if old is None else round(r["before_s"] / r["read_s"], 1)
             del r["path"]
     return {"rounds": rounds, "quick": quick,
             "before_tree": None if before is None else before_label or _describe(before),
@@ -213,7 +213,8 @@ def render(data: dict[str, Any]) -> str:
     ]
     if before:
         lines += [f"The `before` column is the same run's reading with the checkout at "
-                  f"`{before}`, the reader before the bulk routes.", ""]
+                  f"`{before}`, the reader before the bulk routes (such a tree: "
+                  "`git archive COMMIT | tar -x -C DIR`).", ""]
     lines += ["| file | size (MB) | floor (s) | read_instance (s) | ratio to floor | "
               "before (s) | speed-up |",
               "|---|---|---|---|---|---|---|"]
