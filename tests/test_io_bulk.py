@@ -321,3 +321,21 @@ def test_dense_grid_equals_nonzero(sizes, seed, p_inf):
             if np.isfinite(C[idx])]
     got = [(tuple(t), c) for t, c in zip(prob.tuples[real].tolist(), prob.costs[real])]
     assert got == want
+
+
+@pytest.mark.parametrize("block", [0, 1, 2])
+def test_bs_driver_bad_token_names_its_line(tmp_path, block):
+    """The tokens before a Balas-Saltzman block are counted only for the message; the
+    line it names is the bad token's line in the file."""
+    lines = ["AP3 Test Driver", "", "n = 2 to 3 by 1; p = 2", ""]
+    for k, (n, p) in enumerate([(2, 1), (2, 2), (3, 1)]):
+        lines += [f"N = {n}   PROBLEM = {p}", "=" * 45]
+        vals = [str(10 * k + v) for v in range(n ** 3)]
+        if k == block:
+            vals[5] = "x5"
+        lines += [" ".join(vals[:4])] + vals[4:]
+    f = tmp_path / "BalasAndSaltzman.txt"
+    f.write_text("\n".join(lines) + "\n")
+    line = next(i for i, ln in enumerate(lines, 1) if ln == "x5")
+    with pytest.raises(InstanceFormatError, match=f"non-numeric token 'x5' on line {line}$"):
+        read_instance(f, instance=block + 1)
