@@ -197,7 +197,8 @@ def test_bad_entries_among_floats_keep_their_message(costs, msg):
         assert re.search(msg, message), message
 
 
-GOOD = st.one_of(st.integers(-10 ** 6, 10 ** 6), st.floats(-1e6, 1e6, allow_nan=False),
+GOOD = st.one_of(st.integers(-10 ** 6, 10 ** 6), st.integers(-2 ** 63, 2 ** 65),
+                 st.floats(-1e6, 1e6, allow_nan=False), st.floats(-1e300, 1e300),
                  st.sampled_from([math.inf, "inf", " +Infinity", "INF"]))
 
 
