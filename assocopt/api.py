@@ -97,6 +97,12 @@ def solve(problem: AssignmentProblem, solver: str = "auto", *, relax: str | None
     if not isinstance(problem, AssignmentProblem):
         raise InvalidProblemError(
             f"problem must be an AssignmentProblem, got {type(problem).__name__}")
+    if (solver == "auto" or solver == "scipy-lsa") and problem._dense is not None and \
+            not options and relax is None and time_limit is None and threads is None \
+            and verbose is False and type(mip_gap) is float and mip_gap == 0.0:
+        sol = _small_path()(problem, problem._dense, t0)   # a scan's few rows
+        if sol is not None:
+            return sol
     if relax is not None and relax != "lp":
         raise InvalidProblemError(f"relax must be None or 'lp', got {relax!r}")
     name = choose_solver(problem, relax) if solver == "auto" else solver
@@ -128,6 +134,19 @@ def solve(problem: AssignmentProblem, solver: str = "auto", *, relax: str | None
     return sol
 
 
+_SMALL = None
+
+
+def _small_path():
+    """:func:`assocopt.solvers.small2d.solve_small`, imported on first use (it loads
+    scipy, which ``import assocopt`` does not)."""
+    global _SMALL
+    if _SMALL is None:
+        from .solvers.small2d import solve_small
+        _SMALL = solve_small
+    return _SMALL
+
+
 def _uncovered_answer(problem: AssignmentProblem) -> RawResult:
     """The infeasible answer of a problem with real indices no candidate covers."""
     n_missing = problem.n_uncovered
@@ -157,11 +176,13 @@ _SCALE_TO_EXPONENT = 40
 
 
 def _max_abs_cost(problem: AssignmentProblem) -> float:
-    """Largest finite |cost|; for a dense 2-D problem read from its matrix (the
-    candidate list is not built for it), reusing what its validation found."""
+    """Largest finite |cost|, or, for a dense 2-D problem, an upper bound on it when
+    that bound already shows no scaling is needed (read from its matrix, reusing what
+    its validation found; the candidate list is not built for it)."""
     d = problem.dense_view
     if d is not None:
-        return d.max_abs_cost()
+        bound = d.cost_bound()
+        return bound if bound <= SCALE_ABOVE else d.max_abs_cost()
     return _finite_amax(problem.costs)
 
 

@@ -47,8 +47,8 @@ def from_matrix(cls: type, C: np.ndarray, rm: np.ndarray | None, cm: np.ndarray 
                 **kw: Any) -> Any:
     """A 2-D ``AssignmentProblem`` kept as its dense matrix (``C`` validated, owned).
 
-    ``amax``: the largest finite magnitude of ``C``, ``rm``, ``cm`` where the
-    validation found it (None: computed when needed).  Filled in directly rather than
+    ``amax``: upper bounds on the largest finite magnitudes of ``C``, ``rm``, ``cm``
+    where the validation found them (None: computed when needed).  Filled in directly rather than
     through the dataclass's generated ``__init__``: this is the per-scan hot path,
     where every microsecond is measured against scipy."""
     if C.size > MAX_DENSE_CANDIDATES:
@@ -148,8 +148,9 @@ class Dense2D:
     ``all_finite``: no forbidden matrix entry; ``n_pairs``: number of finite entries;
 
     ``miss_index``: the rows and the columns whose miss is a candidate (finite cost);
-    ``miss_flags``: ``(all rm finite, all cm finite)``; ``amax``: the largest finite
-    magnitude of ``C``, ``rm``, ``cm`` where known (see :meth:`max_abs_cost`).
+    ``miss_flags``: ``(all rm finite, all cm finite)``; ``amax``: upper bounds on the
+    largest finite magnitudes of ``C``, ``rm``, ``cm`` where known (see
+    :meth:`cost_bound`).
     Read-only by convention (a plain class: built once per scan, where a frozen
     dataclass's ``__init__`` costs).
     """
@@ -173,7 +174,7 @@ class Dense2D:
               ) -> "Dense2D":
         """From a validated matrix; ``rm = cm = None`` means the ``dense`` kind;
         ``known_finite``: the caller knows all of ``rm`` / ``cm`` is finite (scalars);
-        ``amax``: the magnitudes the validation found (None: not known)."""
+        ``amax``: the magnitude bounds the validation found (None: not known)."""
         n1, n2 = C.shape
         slack = rm is None and cm is None
         if slack:      # the larger side's surplus is free: known without looking
@@ -193,16 +194,21 @@ class Dense2D:
             amax = (amax[0], 0.0, 0.0)
         return cls(C, rm, cm, slack, all_finite, n_pairs, index, flags, amax)
 
-    def max_abs_cost(self) -> float:
-        """Largest finite ``|cost|`` of the matrix and the misses (0 when none): the
-        cost-scaling test of :func:`assocopt.solve`; the magnitudes the validation
-        already found are reused, the others computed (and kept) here."""
+    def cost_bound(self) -> float:
+        """An upper bound on the largest finite ``|cost|`` of the matrix and the misses
+        (0 when none), for the cost-scaling test of :func:`assocopt.solve`: the bounds
+        the validation found are reused (``sqrt`` of a sum of squares, or the exact
+        magnitude), the missing ones computed (and kept) here."""
         known = self.amax
         if None in known:
             known = tuple(_finite_amax(a) if m is None else m
                           for a, m in zip((self.C, self.rm, self.cm), known))
             self.amax = known
         return max(known)
+
+    def max_abs_cost(self) -> float:
+        """The largest finite ``|cost|`` of the matrix and the misses (0 when none)."""
+        return max(_finite_amax(a) for a in (self.C, self.rm, self.cm))
 
     @property
     def shape(self) -> tuple[int, int]:

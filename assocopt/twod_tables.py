@@ -8,7 +8,7 @@ import math
 
 import numpy as np
 
-__all__ = ["_finite_amax", "_index_set", "_row_offsets", "_pair_base"]
+__all__ = ["_finite_amax", "_index_set", "_row_offsets", "_pair_base", "_tuple_table"]
 
 
 def _finite_amax(a: np.ndarray) -> float:
@@ -46,3 +46,17 @@ def _pair_base(n: int) -> np.ndarray:
     a[:, 0] = np.arange(1, n + 1)
     a.setflags(write=False)
     return a
+
+
+@functools.lru_cache(maxsize=256)
+def _tuple_table(n1: int, n2: int) -> np.ndarray:
+    """The reported tuple of every candidate position of an ``n1 x n2`` problem whose
+    entries and misses are all candidates: ``(i + 1, j + 1)`` in row-major order, then
+    ``(i + 1, 0)``, then ``(0, j + 1)``; a checked answer's tuples are one ``take``."""
+    ii, jj = np.divmod(np.arange(n1 * n2, dtype=np.int64), n2)
+    rows, cols = np.arange(1, n1 + 1), np.arange(1, n2 + 1)
+    t = np.concatenate([np.stack([ii + 1, jj + 1], axis=1),
+                        np.stack([rows, np.zeros(n1, np.int64)], axis=1),
+                        np.stack([np.zeros(n2, np.int64), cols], axis=1)])
+    t.setflags(write=False)
+    return t
