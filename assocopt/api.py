@@ -100,7 +100,7 @@ def solve(problem: AssignmentProblem, solver: str = "auto", *, relax: str | None
     if (solver == "auto" or solver == "scipy-lsa") and problem._dense is not None and \
             not options and relax is None and time_limit is None and threads is None \
             and verbose is False and type(mip_gap) is float and mip_gap == 0.0:
-        sol = _small_path()(problem, problem._dense, t0)   # a scan's few rows
+        sol = _direct_path()(problem, problem._dense, t0)   # no dispatch, one pass
         if sol is not None:
             return sol
     if relax is not None and relax != "lp":
@@ -134,17 +134,17 @@ def solve(problem: AssignmentProblem, solver: str = "auto", *, relax: str | None
     return sol
 
 
-_SMALL = None
+_DIRECT = None
 
 
-def _small_path():
-    """:func:`assocopt.solvers.small2d.solve_small`, imported on first use (it loads
+def _direct_path():
+    """:func:`assocopt.solvers.direct2d.solve_direct`, imported on first use (it loads
     scipy, which ``import assocopt`` does not)."""
-    global _SMALL
-    if _SMALL is None:
-        from .solvers.small2d import solve_small
-        _SMALL = solve_small
-    return _SMALL
+    global _DIRECT
+    if _DIRECT is None:
+        from .solvers.direct2d import solve_direct
+        _DIRECT = solve_direct
+    return _DIRECT
 
 
 def _uncovered_answer(problem: AssignmentProblem) -> RawResult:

@@ -1,10 +1,10 @@
-"""The per-scan path of small dense 2-D problems gives the general route's Solution.
+"""The direct route of dense 2-D problems gives the general route's Solution.
 
-:func:`assocopt.solve` answers small dense 2-D problems with default options through
-:mod:`assocopt.solvers.small2d`; here every field of its Solution is compared with the
-general route's (forced by setting ``small2d.SMALL`` to 0) on random problems:
+:func:`assocopt.solve` answers dense 2-D problems with default options through
+:mod:`assocopt.solvers.direct2d`; here every field of its Solution is compared with the
+general route's (forced by switching the direct route off) on random problems:
 rectangular, with and without misses, forbidden entries and misses, maximisation,
-integer costs with many ties, and infeasible ones (which the small path hands back).
+integer costs with many ties, and infeasible ones (which the direct route hands back).
 """
 
 from __future__ import annotations
@@ -16,13 +16,14 @@ import pytest
 from hypothesis import HealthCheck, given, settings, strategies as st
 
 from assocopt import AssignmentProblem, Status, solve
-from assocopt.solvers import small2d
+from assocopt import api
+from assocopt.solvers import direct2d
 from assocopt.values import _as_matrix
 
 
 def _general(problem: AssignmentProblem, monkeypatch) -> object:
     with monkeypatch.context() as m:
-        m.setattr(small2d, "SMALL", 0)
+        m.setattr(api, "_DIRECT", lambda problem, d, t0: None)
         return solve(problem)
 
 
@@ -41,8 +42,9 @@ def _same(a, b) -> None:
 
 
 @st.composite
-def small_problems(draw) -> AssignmentProblem:
-    n1, n2 = draw(st.integers(1, 9)), draw(st.integers(1, 9))
+def twod_problems(draw) -> AssignmentProblem:
+    big = draw(st.sampled_from([9, 9, 9, 40]))       # 40: past the list split
+    n1, n2 = draw(st.integers(1, big)), draw(st.integers(1, big))
     seed = draw(st.integers(0, 2 ** 32 - 1))
     rng = np.random.default_rng(seed)
     ties = draw(st.booleans())
@@ -74,8 +76,8 @@ def small_problems(draw) -> AssignmentProblem:
 
 @settings(max_examples=400, deadline=None,
           suppress_health_check=[HealthCheck.function_scoped_fixture])
-@given(small_problems())
-def test_small_path_equals_general_route(monkeypatch, p):
+@given(twod_problems())
+def test_direct_route_equals_general_route(monkeypatch, p):
     _same(solve(p), _general(p, monkeypatch))
 
 
@@ -91,14 +93,14 @@ def test_each_branch_is_taken_and_agrees(monkeypatch, case):
     else:
         p, branch = AssignmentProblem.two_d(rng.random((8, 6)), 0.4, 0.4), "assign_dense"
     calls = []
-    real = getattr(small2d, branch)
+    real = getattr(direct2d, branch)
 
     def spy(*args, **kw):
         calls.append(1)
         return real(*args, **kw)
 
     with monkeypatch.context() as m:
-        m.setattr(small2d, branch, spy)
+        m.setattr(direct2d, branch, spy)
         fast = solve(p)
     assert calls == [1]
     _same(fast, _general(p, monkeypatch))
@@ -120,8 +122,8 @@ def test_a_wrong_lap_answer_is_not_trusted(monkeypatch):
     def broken(R):
         return np.arange(3), np.zeros(3, np.int64)
 
-    monkeypatch.setattr(small2d, "_lsa", broken)
-    assert small2d.solve_small(p, p.dense_view, 0.0) is None
+    monkeypatch.setattr(direct2d, "_lsa", broken)
+    assert direct2d.solve_direct(p, p.dense_view, 0.0) is None
 
 
 @settings(max_examples=200, deadline=None)
@@ -152,3 +154,17 @@ def test_scaling_still_triggers_just_above_the_threshold():
     assert "cost_scale" in sol.info and sol.objective == 2.0
     C = np.array([[2.0 ** 49, 1.0], [1.0, 2.0 ** 49]])
     assert "cost_scale" not in solve(AssignmentProblem.dense(C)).info
+
+
+@pytest.mark.parametrize("n1, n2, miss", [(150, 150, False), (120, 200, False),
+                                          (60, 90, True), (200, 130, True)])
+def test_larger_problems_agree(monkeypatch, n1, n2, miss):
+    """Beyond the list split: the square branch and the general check at size."""
+    rng = np.random.default_rng(n1 + n2)
+    C = rng.random((n1, n2))
+    if n1 != n2:                     # the square one stays all finite: its own branch
+        C[rng.random(C.shape) < 0.05] = np.inf
+        C[np.arange(min(n1, n2)), np.arange(min(n1, n2))] = 0.5     # stay feasible
+    p = AssignmentProblem.two_d(C, rng.random(n1), rng.random(n2)) if miss else \
+        AssignmentProblem.dense(C)
+    _same(solve(p), _general(p, monkeypatch))

@@ -1,21 +1,24 @@
-"""The per-scan path of small dense 2-D problems: matrix to :class:`Solution` in one pass.
+"""The direct route of dense 2-D problems: matrix to :class:`Solution` in one pass.
 
-A tracker solves a small 2-D assignment every scan.  At ten rows scipy's LAP takes about
-a microsecond, so the general route of :func:`assocopt.solve` (solver dispatch, option
-parsing, the back end's raw result, the common checks) would cost many times the solve.
-:func:`solve_small` does the same work, for the cases it knows, without that route:
+A tracker solves a 2-D assignment every scan, often a small one.  At ten rows scipy's
+LAP takes about a microsecond, so the general route of :func:`assocopt.solve` (solver
+dispatch, option parsing, the back end's raw result, the common checks) would cost
+many times the solve.  :func:`solve_direct` does the same work without that route for
+a problem kept as a dense matrix, solved by ``scipy-lsa`` (what ``auto`` picks) with no
+options, costs in the unscaled range:
 
-* a problem kept as a dense matrix, solved by ``scipy-lsa`` (what ``auto`` picks), with
-  no options, at most :data:`SMALL` rows plus columns, costs in the unscaled range;
-* square without misses: the matrix goes to the LAP as it is;
-* every row and column may be left out, with no more rows than columns: the LAP of the
-  clipped reduced costs ``min(C - rm - cm, 0)`` of :mod:`assocopt.solvers.dense2d`;
-* any other such problem: :func:`~assocopt.solvers.dense2d.assign_dense` and
+* square without misses: the matrix goes to the LAP as it is, the answer must be a
+  permutation (any size);
+* every row and column may be left out, no more rows than columns, at most
+  :data:`SMALL` rows plus columns: the LAP of the clipped reduced costs
+  ``min(C - rm - cm, 0)`` of :mod:`assocopt.solvers.dense2d`, split and priced on
+  Python lists (for a scan's few rows each numpy call costs more than the work);
+* any other: :func:`~assocopt.solvers.dense2d.assign_dense` and
   :meth:`~assocopt.twod.Dense2D.check`, as the general route does.
 
 The answer is re-checked as the general route re-checks it (distinct columns in range,
 no forbidden pair or miss used) and priced by exact summation (``math.fsum``), so the
-``Solution`` is the general route's, field for field (``tests/test_twod_small.py``).
+``Solution`` is the general route's, field for field (``tests/test_twod_direct.py``).
 Anything it does not expect (an infeasible problem, a failed re-check) it leaves to the
 general route by returning None, so every error is reported in one place.
 """
@@ -34,9 +37,9 @@ from ..twod_tables import _index_set, _pair_base, _row_offsets, _tuple_table
 from .dense2d import assign_dense
 from .lap import LapInfeasibleError
 
-__all__ = ["solve_small", "SMALL"]
+__all__ = ["solve_direct", "SMALL"]
 
-#: Problems with at most this many rows + columns take this path.
+#: Problems with misses and at most this many rows + columns are split on lists.
 SMALL = 64
 #: Costs beyond this magnitude are scaled by the general route (assocopt.api.SCALE_ABOVE).
 _SCALE_ABOVE = 2.0 ** 50
@@ -44,18 +47,19 @@ _NAME = "scipy-lsa"
 _MESSAGE = "scipy-lsa: optimal"
 
 
-def solve_small(problem, d, t0: float) -> Solution | None:
+def solve_direct(problem, d, t0: float) -> Solution | None:
     """The :class:`Solution` of ``problem`` (dense view ``d``) by scipy's LAP, or None
     when the general route must answer.  ``t0``: when :func:`assocopt.solve` began."""
     C = d.C
     n1, n2 = C.shape
-    if n1 + n2 > SMALL or n1 == 0 or n2 == 0 or d.cost_bound() > _SCALE_ABOVE:
+    if n1 == 0 or n2 == 0 or d.cost_bound() > _SCALE_ABOVE:
         return None
     t1 = time.perf_counter()
     try:
         if d.all_finite and d.slack and n1 == n2:
             checked, how = _square(C, d), "plain"
-        elif d.all_finite and not d.slack and n1 <= n2 and d.miss_flags == (True, True):
+        elif d.all_finite and not d.slack and n1 <= n2 and n1 + n2 <= SMALL and \
+                d.miss_flags == (True, True):
             checked, how = _clipped(C, d), "reduced"
         else:
             cor, how = assign_dense(C, d.rm, d.cm, d.slack, "scipy", d.miss_flags)
