@@ -26,6 +26,11 @@ INTERRUPTED = threading.Event()
 
 #: How often the waiting thread looks at the clock and at pending signals (seconds).
 POLL = 0.05
+#: How long Ctrl-C waits for a cancelled worker to return (seconds): compiled kernels
+#: return within a chunk of work, but a library may run a phase without looking at its
+#: interrupt hook (HiGHS in presolve or a long LP); then the interrupt is re-raised
+#: anyway and the daemon thread is left to wind down on its own.
+CANCEL_WAIT = 2.0
 
 
 def new_stop() -> np.ndarray:
@@ -52,7 +57,8 @@ def run_cancellable(fn: Callable[..., Any], args: tuple, cancel: Callable[[], No
                     *, deadline: float | None = None,
                     kwargs: dict[str, Any] | None = None) -> tuple[Any, bool]:
     """``(fn(*args), stopped_by_clock)`` with ``fn`` in a worker thread; ``cancel()``
-    asks it to stop (at ``deadline`` or on Ctrl-C), after which it is awaited.
+    asks it to stop (at ``deadline`` or on Ctrl-C), after which it is awaited (on
+    Ctrl-C for at most :data:`CANCEL_WAIT` seconds).
 
     With ``cancel=None`` (a library without an interrupt hook) Ctrl-C is re-raised at
     once and the worker thread (a daemon) is left to finish on its own: the command
@@ -60,30 +66,36 @@ def run_cancellable(fn: Callable[..., Any], args: tuple, cancel: Callable[[], No
     waiting for the solve.
     """
     box: dict[str, Any] = {}
+    finished = threading.Event()
 
     def work() -> None:
         try:
             box["result"] = fn(*args, **(kwargs or {}))
         except BaseException as exc:  # noqa: BLE001 - re-raised in the caller
             box["error"] = exc
+        finally:
+            finished.set()
 
+    # Waiting on an Event, not Thread.join: in Python 3.11 a Ctrl-C that interrupts
+    # join() marks the thread stopped while it still runs (and releases the lock its
+    # exit releases again), so the awaiting below would silently not happen.
     worker = threading.Thread(target=work, name="assocopt-kernel", daemon=True)
     worker.start()
     by_clock = False
     try:
-        while worker.is_alive():
+        while not finished.is_set():
             wait = POLL if deadline is None else min(POLL, max(deadline - time.perf_counter(), 0))
-            worker.join(wait)
-            if deadline is not None and cancel is not None and worker.is_alive() \
+            finished.wait(wait)
+            if deadline is not None and cancel is not None and not finished.is_set() \
                     and time.perf_counter() >= deadline:
                 cancel()
                 by_clock = True
-                worker.join()
+                finished.wait()
     except BaseException:
         INTERRUPTED.set()
         if cancel is not None:    # Ctrl-C (or SIGTERM turned into it): stop, then re-raise
             cancel()
-            worker.join()
+            finished.wait(CANCEL_WAIT)
         raise
     if "error" in box:
         raise box["error"]
