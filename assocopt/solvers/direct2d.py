@@ -119,6 +119,8 @@ def _clipped(C: np.ndarray, d) -> Checked | None:
     prices = C.take(flat).tolist()
     flat_l = flat.tolist()
     col_l = cols.tolist()
+    if len(set(col_l)) != n1 or min(col_l) < 0 or max(col_l) >= n2:
+        return None              # the LAP's answer re-checked: distinct, in range
     rl = d.rm.tolist()
     base_r = n1 * n2
     pos: list[int] = []          # candidate positions: the pairs (row order) ...
@@ -127,10 +129,7 @@ def _clipped(C: np.ndarray, d) -> Checked | None:
     used = [False] * n2
     for i in range(n1):
         if reduced[i] < 0.0:
-            j = col_l[i]
-            if j < 0 or j >= n2 or used[j]:     # the LAP's answer re-checked
-                return None
-            used[j] = True
+            used[col_l[i]] = True
             pos.append(flat_l[i])
             terms.append(prices[i])
         else:
