@@ -27,6 +27,7 @@ from assocopt.cli import _build_parser, main
 
 ROOT = Path(__file__).resolve().parents[1]
 GUIDE = ROOT / "docs" / "guide.md"
+README = ROOT / "README.md"
 
 _FENCE = re.compile(r"(?:<!--\s*guide-test:\s*write\s+(?P<target>\S+)\s*-->\s*\n)?"
                     r"^```(?P<lang>[\w-]*)[ \t]*\n(?P<body>.*?)^```[ \t]*$",
@@ -35,9 +36,9 @@ _EXIT = re.compile(r"#\s*exit\s+(\d+)\s*$")
 _SKIP = ("pip install", "python -m pytest")
 
 
-def blocks() -> list[tuple[str, str, str | None, int]]:
-    """``(language, body, write-target, line number)`` of every fenced block."""
-    text = GUIDE.read_text(encoding="utf-8")
+def blocks(page: Path = GUIDE) -> list[tuple[str, str, str | None, int]]:
+    """``(language, body, write-target, line number)`` of every fenced block of a page."""
+    text = page.read_text(encoding="utf-8")
     return [(m["lang"], m["body"], m["target"], text.count("\n", 0, m.start("body")) + 1)
             for m in _FENCE.finditer(text)]
 
@@ -152,3 +153,27 @@ def test_sample_output_in_the_guide_is_real(capsys):
     assert main(["solve", str(ROOT / "instances" / "example-3d.json")]) == 0
     real = capsys.readouterr().out.splitlines()
     assert real[:len(shown)] == shown
+
+
+def test_readme_first_commands_and_python_run(workspace, capsys):
+    """README's "Set up and run" block prints what the README says; its Python runs."""
+    setup = next(body for lang, body, _, _ in blocks(README) if lang == "bash")
+    commands = [ln.strip() for ln in setup.splitlines() if ln.strip()]
+    assert commands[0].startswith("pip install") and len(commands) == 2
+    assert main(_argv(commands[1], workspace)) == 0
+    out = capsys.readouterr().out
+    for field in ("status", "objective", "bound", "gap", "solver", "tuples"):
+        assert re.search(rf"^{field}\b", out, re.MULTILINE), (field, out)
+    assert main(["instances"]) == 0 and "example-3d" in capsys.readouterr().out
+    assert main(["solve", "example-3d"]) == 0 and "optimal" in capsys.readouterr().out
+    python = [(body, line) for lang, body, _, line in blocks(README) if lang == "python"]
+    assert python, "README shows the Python API"
+    namespace: dict = {"__name__": "readme"}
+    for body, line in python:
+        exec(compile(body, f"README.md:{line}", "exec"), namespace)
+    sol, lp, ranked, m = (namespace[k] for k in ("sol", "lp", "ranked", "m"))
+    assert (sol.status, sol.gap) == ("optimal", 0.0) and sol.bound == sol.objective
+    assert lp.objective <= sol.objective + 1e-9
+    assert namespace["solve"](namespace["p3"]).tuples.tolist() == [[1, 1, 1], [2, 2, 2]]
+    assert len(ranked) == 10 and list(ranked.objectives) == sorted(ranked.objectives)
+    assert abs(m.pairs.sum(axis=1) + m.row_miss - 1).max() < 1e-9
