@@ -116,6 +116,9 @@ def kbest(problem: AssignmentProblem, k: int, solver: str = "auto", **options: A
             f"problem must be an AssignmentProblem, got {type(problem).__name__}")
     if isinstance(k, bool) or not isinstance(k, (int, np.integer)) or k < 1:
         raise InvalidProblemError(f"k must be a positive integer, got {k!r}")
+    if options.get("relax") is not None:
+        raise InvalidProblemError(
+            f"kbest ranks integer solutions; relax={options['relax']!r} is not supported")
     if problem.ndim == 2 and solver == "auto" and not options:
         from . import kbest2d
 

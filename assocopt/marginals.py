@@ -19,6 +19,7 @@ columns and its miss.  How close the k-best sum gets is measured in
 from __future__ import annotations
 
 import math
+import numbers
 from dataclasses import dataclass
 
 import numpy as np
@@ -66,8 +67,8 @@ def marginals(problem: AssignmentProblem, k: int = 100, temperature: float = 1.0
     >>> m.hypotheses, m.exhaustive, round(float(m.pairs[0].sum() + m.row_miss[0]), 12)
     (3, True, 1.0)
     """
-    if not (isinstance(temperature, (int, float)) and math.isfinite(temperature)
-            and temperature > 0):
+    if (isinstance(temperature, bool) or not isinstance(temperature, numbers.Real)
+            or not (math.isfinite(temperature) and temperature > 0)):
         raise InvalidProblemError(f"temperature must be a positive number, got {temperature!r}")
     if method not in METHODS:
         raise InvalidProblemError(f"method must be one of {METHODS}, got {method!r}")

@@ -658,3 +658,47 @@ def test_math_is_exact_for_power_of_two_scaling():
     assert sol.objective == ref.objective * 2.0 ** 900
     assert math.isfinite(sol.bound) and sol.bound <= sol.objective
     assert sol.info["cost_scale"] > 1
+
+
+# ------------------------------------------------------------------ API edge inputs
+class TestRankingEdgeInputs:
+    """kbest / marginals on awkward but legal inputs: a right answer or a clear error."""
+
+    def test_kbest_rejects_relax_by_name(self):
+        from assocopt import kbest
+
+        p = AssignmentProblem.dense(np.random.default_rng(3).random((3, 3, 3)))
+        with pytest.raises(InvalidProblemError, match="relax='lp' is not supported"):
+            kbest(p, 2, solver="highs", relax="lp")
+
+    def test_marginals_temperature_numpy_scalar_and_bool(self):
+        from assocopt import marginals
+
+        p = AssignmentProblem.two_d([[0.0, 5.0]], 1.0, 1.0)
+        a = marginals(p, k=5, temperature=np.float32(0.5))
+        b = marginals(p, k=5, temperature=0.5)
+        assert np.allclose(a.candidate, b.candidate)
+        for bad in (True, "1", 0.0, -1.0, math.inf, math.nan):
+            with pytest.raises(InvalidProblemError, match="temperature must be a positive"):
+                marginals(p, temperature=bad)
+
+    @pytest.mark.parametrize("k", [0, -1, 1.5, True, math.inf])
+    def test_kbest_bad_k(self, k):
+        from assocopt import kbest
+
+        with pytest.raises(InvalidProblemError, match="k must be a positive integer"):
+            kbest(AssignmentProblem.dense([[1.0]]), k)
+
+    def test_kbest_degenerate_shapes(self):
+        from assocopt import kbest
+
+        one = kbest(AssignmentProblem.dense([[3.0]]), 10**30)
+        assert one.objectives == [3.0] and one.exhausted
+        empty = kbest(AssignmentProblem.two_d(np.zeros((0, 3)), 1.0, 2.0), 3)
+        assert empty.objectives == [6.0] and empty.exhausted
+        row = kbest(AssignmentProblem.dense(np.arange(50.0)[None, :]), 5)
+        assert row.objectives == [0.0, 1.0, 2.0, 3.0, 4.0]
+        col = kbest(AssignmentProblem.dense(np.arange(50, dtype=np.int32)[:, None]), 60)
+        assert col.objectives == [float(v) for v in range(50)] and col.exhausted
+        none = kbest(AssignmentProblem.dense([[math.inf, 1.0], [math.inf, 2.0]]), 3)
+        assert len(none) == 0 and none.exhausted
