@@ -99,8 +99,8 @@ def kbest(problem: AssignmentProblem, k: int, solver: str = "auto", **options: A
     """The ``k`` best feasible solutions of ``problem``, best first (see the module).
 
     ``solver``: an exact back end for the subproblems (``"auto"``: the compiled 2-D
-    ranking, or the exact S-D back end :func:`assocopt.choose_solver` picks); ``options``
-    go to it.  ``Ranked.times`` has ``total`` and, when the call compiled the 2-D kernel
+    ranking, reported as ``"murty2d"`` and also accepted by that name, or the exact S-D
+    back end :func:`assocopt.choose_solver` picks); ``options`` go to it.  ``Ranked.times`` has ``total`` and, when the call compiled the 2-D kernel
     or loaded it from numba's disk cache, ``compile`` / ``cache_load`` seconds.
 
     Examples
@@ -119,6 +119,12 @@ def kbest(problem: AssignmentProblem, k: int, solver: str = "auto", **options: A
     if options.get("relax") is not None:
         raise InvalidProblemError(
             f"kbest ranks integer solutions; relax={options['relax']!r} is not supported")
+    if solver == "murty2d":                 # the name the compiled ranking reports
+        if problem.ndim != 2:
+            raise SolverCapabilityError(
+                f"solver 'murty2d' ranks 2-D problems only; this one has {problem.ndim} "
+                "axes (use solver='auto' or an exact S-D back end)")
+        solver = "auto"
     if problem.ndim == 2 and solver == "auto" and not options:
         from . import kbest2d
 

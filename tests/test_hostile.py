@@ -702,3 +702,17 @@ class TestRankingEdgeInputs:
         assert col.objectives == [float(v) for v in range(50)] and col.exhausted
         none = kbest(AssignmentProblem.dense([[math.inf, 1.0], [math.inf, 2.0]]), 3)
         assert len(none) == 0 and none.exhausted
+
+    def test_kbest_takes_the_name_it_reports(self, capsys):
+        from assocopt import kbest
+        from assocopt.errors import SolverCapabilityError
+
+        p = AssignmentProblem.two_d([[1.0, 2.0], [3.0, 1.0]], 2.0, 2.0)
+        r = kbest(p, 4)
+        assert r.solver == "murty2d"
+        assert kbest(p, 4, solver="murty2d").objectives == r.objectives
+        with pytest.raises(SolverCapabilityError, match="2-D problems only"):
+            kbest(AssignmentProblem.dense(np.ones((2, 2, 2))), 2, solver="murty2d")
+        code, out, err = cli(capsys, "solve", ROOT / "instances" / "example-3d.json",
+                             "--kbest", "2", "--solver", "murty2d")
+        assert code == 2 and len(err.strip().splitlines()) == 1 and "2-D" in err

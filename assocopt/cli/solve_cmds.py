@@ -75,7 +75,7 @@ def _kbest_note(problem: Any, solver: str, err: TextIO) -> bool:
     """:func:`_compile_note` for the compiled 2-D ranking of ``--kbest``."""
     from .. import kbest2d
 
-    if problem.ndim != 2 or solver != "auto" or not kbest2d.available():
+    if problem.ndim != 2 or solver not in ("auto", kbest2d.NAME) or not kbest2d.available():
         return False
     from ..solvers import bnb_kernels
     from ..solvers.kernels.murty2d import murty
