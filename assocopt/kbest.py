@@ -98,10 +98,13 @@ def kbest(problem: AssignmentProblem, k: int, solver: str = "auto", **options: A
           ) -> Ranked:
     """The ``k`` best feasible solutions of ``problem``, best first (see the module).
 
+    ``k``: a positive integer (any size: fewer come back when fewer exist).
     ``solver``: an exact back end for the subproblems (``"auto"``: the compiled 2-D
     ranking, reported as ``"murty2d"`` and also accepted by that name, or the exact S-D
-    back end :func:`assocopt.choose_solver` picks); ``options`` go to it.  ``Ranked.times`` has ``total`` and, when the call compiled the 2-D kernel
-    or loaded it from numba's disk cache, ``compile`` / ``cache_load`` seconds.
+    back end :func:`assocopt.choose_solver` picks); ``options`` go to it (``relax`` is
+    refused: the ranking is over integer solutions).  ``Ranked.times`` has ``total``
+    and, when the call compiled the 2-D kernel or loaded it from numba's disk cache,
+    ``compile`` / ``cache_load`` seconds.
 
     Examples
     --------

@@ -60,6 +60,11 @@ def marginals(problem: AssignmentProblem, k: int = 100, temperature: float = 1.0
               method: str = "kbest", solver: str = "auto") -> Marginals:
     """Marginal association probabilities of ``problem`` (see the module docstring).
 
+    ``k``: how many best hypotheses ``method="kbest"`` sums (ignored by
+    ``"enumerate"``); ``temperature``: a positive finite number; ``solver``: the exact
+    back end of :func:`assocopt.kbest`.  A problem without a feasible solution is an
+    :class:`~assocopt.InvalidProblemError`.
+
     Examples
     --------
     >>> from assocopt import AssignmentProblem
