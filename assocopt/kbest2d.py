@@ -37,7 +37,7 @@ import numpy as np
 from .problem import AssignmentProblem
 from .solution import Solution, Status
 
-__all__ = ["available", "lap_form", "kbest_2d", "NAME"]
+__all__ = ["available", "lap_form", "form_entries", "kbest_2d", "NAME"]
 
 #: The name the compiled ranking reports as its solver.
 NAME = "murty2d"
@@ -85,6 +85,20 @@ def lap_form(C: np.ndarray, rm: np.ndarray, cm: np.ndarray) -> LapForm | None:
     return LapForm(A, n1, tr, n2)
 
 
+def form_entries(rm: np.ndarray, cm: np.ndarray) -> int:
+    """How many entries :func:`lap_form` allocates for miss costs ``(rm, cm)`` (sizes
+    ``n1 = len(rm)``, ``n2 = len(cm)``), without building it."""
+    n1, n2 = len(rm), len(cm)
+    fr, fc = int(np.isfinite(rm).sum()), int(np.isfinite(cm).sum())
+    if fr == 0 and fc == 0:
+        return n1 * n2
+    if fc == n2 and (fr < n1 or n1 <= n2):
+        return n1 * (n2 + fr)
+    if fr == n1:
+        return n2 * (n1 + fc)
+    return (n1 + n2) ** 2
+
+
 def _rectangular(C: np.ndarray, a_miss: np.ndarray, a_free: np.ndarray,
                  b_miss: np.ndarray, transposed: bool) -> LapForm:
     """``[C - b_miss, own miss columns of the rows that may be left out]``."""
@@ -105,12 +119,12 @@ def kbest_2d(problem: AssignmentProblem, k: int) -> tuple[list[Solution], bool, 
 
     d = problem.dense_view
     n1, n2 = problem.sizes
-    if min(n1, n2) == 0 or (n1 + n2) ** 2 > MAX_FORM_ENTRIES:
+    if min(n1, n2) == 0:
         return None
-    if d is not None:
-        C, rm, cm = d.C, d.rm, d.cm
-    else:
-        C, rm, cm = problem.to_cost_matrix(), *problem.miss_costs()
+    rm, cm = (d.rm, d.cm) if d is not None else problem.miss_costs()
+    if form_entries(rm, cm) > MAX_FORM_ENTRIES:
+        return None
+    C = d.C if d is not None else problem.to_cost_matrix()
     form = lap_form(C, rm, cm)
     if form is None:
         return [], True, 1, {}

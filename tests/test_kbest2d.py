@@ -236,3 +236,31 @@ def test_times_report_total_and_kernel_preparation_apart():
     r = kbest(AssignmentProblem.two_d(np.eye(3), 0.5, 0.5), 5)
     assert set(r.times) <= {"total", "compile", "cache_load"} and r.times["total"] > 0
     assert r.to_dict()["solver"] == kbest2d.NAME and r.to_dict()["found"] == 5
+
+
+@settings(max_examples=60, deadline=None)
+@given(st.integers(1, 6), st.integers(1, 6), st.data())
+def test_form_entries_is_the_size_lap_form_allocates(n1, n2, data):
+    rm = np.array(data.draw(st.lists(st.sampled_from([1.0, np.inf]), min_size=n1,
+                                     max_size=n1)))
+    cm = np.array(data.draw(st.lists(st.sampled_from([1.0, np.inf]), min_size=n2,
+                                     max_size=n2)))
+    form = kbest2d.lap_form(np.ones((n1, n2)), rm, cm)
+    if form is not None:
+        assert kbest2d.form_entries(rm, cm) == form.A.size
+
+
+def test_size_cap_applies_to_the_form_built_not_the_augmentation(monkeypatch):
+    """A 10 x 10 problem with every miss allowed ranks on a 10 x 20 form (200 entries),
+    not on the 20 x 20 augmentation: under a 300-entry cap it still takes the compiled
+    path; with a mandatory row and column (the augmentation) it does not."""
+    monkeypatch.setattr(kbest2d, "MAX_FORM_ENTRIES", 300)
+    C = np.random.default_rng(5).random((10, 10))
+    free = kbest(AssignmentProblem.two_d(C, 0.3, 0.3), 4)
+    assert free.solver == "murty2d"
+    miss = np.full(10, 0.3)
+    miss[0] = np.inf                      # row 1 and column 1 must be assigned
+    tight = kbest(AssignmentProblem.two_d(C, miss, miss), 4)
+    assert tight.solver != "murty2d"
+    generic = kbest(AssignmentProblem.two_d(C, 0.3, 0.3), 4, solver="scipy-lsa")
+    assert np.allclose(free.objectives, generic.objectives)
