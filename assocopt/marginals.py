@@ -84,9 +84,15 @@ def marginals(problem: AssignmentProblem, k: int = 100, temperature: float = 1.0
         sels = [s.selected for s in ranked]
         exhaustive = ranked.exhausted
     else:
+        from .errors import ProblemTooLargeError
         from .solvers.bruteforce import enumerate_solutions
 
-        sels = list(enumerate_solutions(problem))
+        try:
+            sels = list(enumerate_solutions(problem))
+        except ProblemTooLargeError as exc:
+            raise ProblemTooLargeError(
+                f"method='enumerate' is for small problems: {exc.args[0].split(';')[0]}; "
+                "use method='kbest' (the k best hypotheses) instead") from None
         exhaustive = True
     if not sels:
         raise InvalidProblemError("the problem has no feasible solution: no marginals")

@@ -716,3 +716,10 @@ class TestRankingEdgeInputs:
         code, out, err = cli(capsys, "solve", ROOT / "instances" / "example-3d.json",
                              "--kbest", "2", "--solver", "murty2d")
         assert code == 2 and len(err.strip().splitlines()) == 1 and "2-D" in err
+
+    def test_marginals_enumerate_too_large_points_to_kbest(self):
+        from assocopt import marginals
+
+        p = AssignmentProblem.dense(np.random.default_rng(0).random((30, 30)))
+        with pytest.raises(ProblemTooLargeError, match="use method='kbest'"):
+            marginals(p, method="enumerate")
