@@ -264,3 +264,15 @@ def test_size_cap_applies_to_the_form_built_not_the_augmentation(monkeypatch):
     assert tight.solver != "murty2d"
     generic = kbest(AssignmentProblem.two_d(C, 0.3, 0.3), 4, solver="scipy-lsa")
     assert np.allclose(free.objectives, generic.objectives)
+
+
+def test_guide_states_the_compiled_ranking_size_cap():
+    from pathlib import Path
+
+    guide = (Path(__file__).resolve().parents[1] / "docs" / "guide.md").read_text()
+    text = " ".join(guide.split())
+    assert kbest2d.MAX_FORM_ENTRIES == 8_000_000 and "at most 8 million entries" in text
+    assert "e.g. 2000 x 2000 when every track and measurement may stay unassigned" in text
+    miss = np.ones(2000)
+    assert kbest2d.form_entries(miss, miss) <= kbest2d.MAX_FORM_ENTRIES
+    assert kbest2d.form_entries(np.ones(2001), np.ones(2001)) > kbest2d.MAX_FORM_ENTRIES
