@@ -38,13 +38,15 @@ def augmented_matrix(C: np.ndarray, row_miss: np.ndarray, col_miss: np.ndarray) 
 
 @register
 class ScipyLsaBackend(Backend):
-    """Exact 2-D assignment with ``scipy.optimize.linear_sum_assignment``."""
+    """Exact 2-D assignment with ``scipy.optimize.linear_sum_assignment`` (large gated
+    candidate lists: the compiled sparse engine of :mod:`assocopt.solvers.sparse2d`)."""
 
     name = "scipy-lsa"
     module = "scipy"
     distribution = "scipy"
     description = ("scipy.optimize.linear_sum_assignment, 2-D only (the dense matrix kept; "
-                   "miss costs by clipped reduced costs)")
+                   "miss costs by clipped reduced costs) / compiled sparse LAP (gated "
+                   "lists)")
     max_ndim = 2
 
     def solve(self, problem: AssignmentProblem, options: SolveOptions) -> RawResult:
