@@ -723,3 +723,30 @@ class TestRankingEdgeInputs:
         p = AssignmentProblem.dense(np.random.default_rng(0).random((30, 30)))
         with pytest.raises(ProblemTooLargeError, match="use method='kbest'"):
             marginals(p, method="enumerate")
+
+    @pytest.mark.parametrize("extra, needle", [
+        (["--kbest", "0"], "--kbest must be a positive integer, got 0"),
+        (["--kbest", "-3"], "--kbest must be a positive integer, got -3"),
+        (["--kbest", "x"], "--kbest: invalid int value"),
+        (["--kbest", "2", "--solver", "greedy"], "kbest needs an exact solver"),
+        (["--kbest", "2", "--solver", "no-such"], "unknown solver 'no-such'"),
+        (["--kbest", "2", "--time-limit", "5"], "--kbest does not combine with --time-limit"),
+        (["--kbest", "2", "--model", "highs-ilp"], "--kbest does not combine with --model"),
+    ])
+    def test_cli_kbest_bad_arguments(self, capsys, extra, needle):
+        code, out, err = cli(capsys, "solve", ROOT / "instances" / "example-2d-miss.json",
+                             *extra)
+        assert code == 2 and len(err.strip().splitlines()) == 1, err
+        assert needle in err and "Traceback" not in err
+
+    def test_cli_kbest_huge_k_lists_every_solution(self, capsys):
+        code, out, _ = cli(capsys, "solve", ROOT / "instances" / "example-2d-miss.json",
+                           "--kbest", str(10**25), "--json")
+        rec = json.loads(out)
+        assert code == 0 and rec["exhausted"] and rec["found"] == len(rec["solutions"])
+        objs = [s["objective"] for s in rec["solutions"]]
+        assert objs == sorted(objs) and objs[0] == -6
+        from assocopt.solvers.bruteforce import enumerate_solutions
+
+        problem = read_instance(ROOT / "instances" / "example-2d-miss.json")
+        assert rec["found"] == sum(1 for _ in enumerate_solutions(problem))
