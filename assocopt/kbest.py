@@ -10,7 +10,8 @@ first ``s_t`` it lacks), so the children's optima, taken cheapest first, rank ev
 feasible solution exactly once.  Slack candidates (the free surplus of a rectangular
 ``dense`` problem) are never split on: the real tuples fix them.
 
-2-D problems (``solver="auto"``, numba installed) are ranked in one compiled call
+2-D problems (``solver="auto"``, numba installed, a LAP form of at most
+:data:`assocopt.kbest2d.MAX_FORM_ENTRIES` entries) are ranked in one compiled call
 (:mod:`assocopt.kbest2d`, kernel :mod:`assocopt.solvers.kernels.murty2d`): each
 subproblem is solved from its parent's solution and duals by one shortest augmenting
 path, children wait on the heap unsolved under a lower bound, and the partition is
@@ -19,7 +20,7 @@ is one choice vector, so none comes back twice.  Equal objectives come out in th
 order of their candidate positions (``Solution.selected``, lexicographically).
 
 The generic path below serves S-D problems, named 2-D solvers (``"scipy-lsa"``,
-``"lapjv"``) and 2-D problems when numba is missing: children are put on the heap
+``"lapjv"``), 2-D problems when numba is missing and larger ones: children are put on the heap
 *unsolved*, with their parent's objective as a lower bound, and solved only when they
 reach the top; a 2-D problem's subproblems are solved on its dense matrix with
 forbidden entries set to ``inf`` (the dense engine of :mod:`assocopt.solvers.dense2d`),
