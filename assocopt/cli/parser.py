@@ -63,9 +63,9 @@ def _build_parser() -> argparse.ArgumentParser:
     ps.add_argument("--out", metavar="SOLUTION.json", default=None,
                     help="also write the solution as JSON to this file")
     ps.add_argument("--kbest", type=int, metavar="K", default=None,
-                    help="the K best solutions, best first (Murty's ranking); takes "
-                         "--solver (an exact back end) and --json, no other solve "
-                         "option")
+                    help="the K best solutions, best first (Murty's ranking); "
+                         "--solver must name an exact back end; not with --model, "
+                         "--relax, --time-limit, --gap, --threads or --out")
 
     pl = sub.add_parser("solvers", help="list the back ends and their capabilities",
                         description="List every registered back end, installed or not.")
