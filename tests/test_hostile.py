@@ -750,3 +750,19 @@ class TestRankingEdgeInputs:
 
         problem = read_instance(ROOT / "instances" / "example-2d-miss.json")
         assert rec["found"] == sum(1 for _ in enumerate_solutions(problem))
+
+    def test_cli_kbest_help_lists_exactly_the_refused_options(self, capsys):
+        import re
+
+        code, out, _ = cli(capsys, "solve", "--help")
+        assert code == 0
+        text = " ".join(out.split())
+        listed = re.search(r"--kbest K .*?not with (.*?--out)", text).group(1)
+        flags = re.findall(r"--[a-z-]+", listed)
+        assert len(flags) == 6
+        values = {"--model": "highs-ilp", "--relax": "lp", "--time-limit": "5",
+                  "--gap": "0.1", "--threads": "1", "--out": "x.json"}
+        for flag in flags:
+            code, _, err = cli(capsys, "solve", ROOT / "instances" / "example-3d.json",
+                               "--kbest", "2", flag, values[flag])
+            assert code == 2 and f"--kbest does not combine with {flag}" in err
