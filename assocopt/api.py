@@ -2,8 +2,6 @@
 
 from __future__ import annotations
 
-import dataclasses
-import math
 import time
 from typing import Any
 
@@ -15,7 +13,7 @@ from .solution import Solution, Status
 from .solvers.base import (Backend, RawResult, SolveOptions, check_capabilities,
                            empty_answer, get_backend, module_installed)
 from .solvers.kernels import spent
-from .twod_tables import _finite_amax
+from .scaling import solve_in_range
 
 __all__ = ["solve", "choose_solver", "BNB_MAX_CANDIDATES"]
 
@@ -124,7 +122,7 @@ def solve(problem: AssignmentProblem, solver: str = "auto", *, relax: str | None
         raw = empty_answer(problem, opts)
     else:
         k0 = spent()
-        raw = _solve_scaled(backend_cls(), problem, opts)
+        raw = solve_in_range(backend_cls(), problem, opts)
         k1 = spent()
         if k1 != k0:
             _kernel_times(raw, k0, k1)
@@ -167,43 +165,6 @@ def _kernel_times(raw: RawResult, before: tuple[float, float],
     compiled, loaded = (a - b for a, b in zip(after, before))
     if compiled > 0 or loaded > 0:
         raw.info = dict(raw.info, compile_time=compiled, cache_load_time=loaded)
-#: Costs larger than this in magnitude are scaled by a power of two before a back end
-#: sees them (exact in floating point), so that HiGHS (which treats |c| >= 1e20 as
-#: infinite), CP-SAT's integer scaling and the Lagrangian sums all work on moderate
-#: numbers; the objective is recomputed from the original costs, the bound scaled back.
-SCALE_ABOVE = 2.0 ** 50
-_SCALE_TO_EXPONENT = 40
-
-
-def _max_abs_cost(problem: AssignmentProblem) -> float:
-    """Largest finite |cost|, or, for a dense 2-D problem, an upper bound on it when
-    that bound already shows no scaling is needed (read from its matrix, reusing what
-    its validation found; the candidate list is not built for it)."""
-    d = problem.dense_view
-    if d is not None:
-        bound = d.cost_bound()
-        return bound if bound <= SCALE_ABOVE else d.max_abs_cost()
-    return _finite_amax(problem.costs)
-
-
-def _solve_scaled(backend: Backend, problem: AssignmentProblem,
-                  opts: SolveOptions) -> RawResult:
-    """``backend.solve`` on ``problem`` with its costs scaled into a safe range if needed."""
-    amax = _max_abs_cost(problem)
-    if amax <= SCALE_ABOVE:
-        return backend.solve(problem, opts)
-    shift = math.frexp(amax)[1] - _SCALE_TO_EXPONENT
-    factor = math.ldexp(1.0, shift)
-    scaled = dataclasses.replace(problem, costs=np.ldexp(problem.costs, -shift),
-                                 optimum=None, meta=dict(problem.meta))
-    scaled.costs.setflags(write=False)
-    raw = backend.solve(scaled, opts)
-    if raw.bound is not None and math.isfinite(raw.bound):
-        raw.bound = raw.bound * factor
-    if raw.objective is not None and math.isfinite(raw.objective):
-        raw.objective = raw.objective * factor
-    raw.info = {**raw.info, "cost_scale": factor}
-    return raw
 
 
 _INTEGRAL_TOL = 1e-6

@@ -768,12 +768,10 @@ class TestRankingEdgeInputs:
             assert code == 2 and f"--kbest does not combine with {flag}" in err
 
 
-@pytest.mark.xfail(reason="known bug: a big-M cost >= 2**50 makes solve() scale every cost by "
-                          "a power of two, which pushes the ordinary costs below HiGHS's "
-                          "absolute tolerances; highs / scipy / cvxpy then report a wrong "
-                          "'optimal' with a bound above the optimum", strict=False)
-@pytest.mark.parametrize("solver", ["highs", "scipy"])
+@pytest.mark.parametrize("solver", ["highs", "scipy", "cvxpy", "ortools-mip"])
 def test_big_m_cost_keeps_highs_optimal_and_bound_valid(solver):
+    """A big-M "forbidden" cost no longer drowns the ordinary ones (tests/test_scaling.py
+    has the general check)."""
     C = np.random.default_rng(0).integers(0, 10, (4, 4)).astype(float)
     C[0, 0] = 1e20                                    # "forbidden" written as big-M
     p = AssignmentProblem.dense(C)

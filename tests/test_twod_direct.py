@@ -148,12 +148,17 @@ def test_range_bound_from_the_sum_of_squares(values):
 
 
 def test_scaling_still_triggers_just_above_the_threshold():
-    """The bound never hides a magnitude above 2**50: such costs are scaled."""
+    """The bound never hides a magnitude above 2**50: such costs never reach the back
+    end as they are (here set aside as unused big-M; needed, they are scaled)."""
     C = np.array([[2.0 ** 51, 1.0], [1.0, 2.0 ** 51]])
     sol = solve(AssignmentProblem.dense(C))
-    assert "cost_scale" in sol.info and sol.objective == 2.0
+    assert sol.info["big_m"]["set_aside"] == 2 and sol.objective == 2.0
+    C = np.array([[2.0 ** 51, 2.0 ** 51], [1.0, 2.0]])
+    sol = solve(AssignmentProblem.dense(C))
+    assert "cost_scale" in sol.info and sol.objective == 2.0 ** 51 + 1.0
     C = np.array([[2.0 ** 49, 1.0], [1.0, 2.0 ** 49]])
-    assert "cost_scale" not in solve(AssignmentProblem.dense(C)).info
+    info = solve(AssignmentProblem.dense(C)).info
+    assert "cost_scale" not in info and "big_m" not in info
 
 
 @pytest.mark.parametrize("n1, n2, miss", [(150, 150, False), (120, 200, False),

@@ -41,7 +41,7 @@ __all__ = ["solve_direct", "SMALL"]
 
 #: Problems with misses and at most this many rows + columns are split on lists.
 SMALL = 64
-#: Costs beyond this magnitude are scaled by the general route (assocopt.api.SCALE_ABOVE).
+#: Costs beyond this magnitude go to the general route (assocopt.scaling.SCALE_ABOVE).
 _SCALE_ABOVE = 2.0 ** 50
 _NAME = "scipy-lsa"
 _MESSAGE = "scipy-lsa: optimal"
