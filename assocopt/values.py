@@ -30,14 +30,20 @@ def _as_cost_array(values: ArrayLike, what: str, maximize: bool = False) -> np.n
 def _reject_non_finite(arr: np.ndarray, what: str, maximize: bool) -> None:
     """Raise on NaN and on the infinity that is not "forbidden" (see _as_cost_array)."""
     if np.isnan(arr).any():
-        where = tuple(int(i) for i in np.argwhere(np.isnan(arr))[0])
-        raise InvalidProblemError(f"{what} contains NaN (first at index {where})")
+        raise InvalidProblemError(f"{what} {_where_first(np.isnan(arr), 'NaN')}")
     if np.isneginf(arr).any():
-        where = tuple(int(i) for i in np.argwhere(np.isneginf(arr))[0])
         bad, ok = ("+inf", "-inf") if maximize else ("-inf", "+inf")
         extra = " with maximize=True" if maximize else ""
-        raise InvalidProblemError(f"{what} contains {bad} (first at index {where}); "
+        raise InvalidProblemError(f"{what} {_where_first(np.isneginf(arr), bad)}; "
                                   f"{ok} means forbidden{extra}")
+
+
+def _where_first(mask: np.ndarray, bad: str) -> str:
+    """``is NaN`` for a scalar, ``contains NaN (first at index (i, j))`` for an array."""
+    if mask.ndim == 0:
+        return f"is {bad}"
+    where = tuple(int(i) for i in np.argwhere(mask)[0])
+    return f"contains {bad} (first at index {where})"
 
 
 def _as_matrix(values: ArrayLike, what: str, maximize: bool

@@ -104,3 +104,11 @@ def test_small_and_bulk_checks_agree_on_rectangular_dense(seed):
         if not isinstance(a, str):
             assert np.array_equal(a.selected, b.selected)
             assert np.array_equal(a.tuples, b.tuples) and a.objective == b.objective
+
+
+@pytest.mark.parametrize("bad, word", [(np.nan, "is NaN"), (-np.inf, "is -inf")])
+def test_a_scalar_miss_cost_is_named_as_a_scalar(bad, word):
+    with pytest.raises(InvalidProblemError, match=f"^row_miss {word}"):
+        AssignmentProblem.two_d(np.ones((2, 2)), bad, 1.0)
+    with pytest.raises(InvalidProblemError, match=r"contains NaN \(first at index \(1,\)\)"):
+        AssignmentProblem.two_d(np.ones((2, 2)), [0.5, np.nan], 1.0)
