@@ -1,7 +1,14 @@
 """S-D assignment at scale: Lagrangian relaxation against MILP and CP solvers, one run.
 
-    python benchmarks/sd_scaling.py            # full run, writes docs/benchmarks-sd.md
+    python benchmarks/sd_scaling.py --reference-all   # full run: docs/benchmarks-sd.json,
+                                                      # .md and .png
     python benchmarks/sd_scaling.py --quick    # smoke run (small instances only)
+    python benchmarks/sd_scaling.py --render   # page and figure from the committed JSON
+
+The run writes the raw results with the environment (versions, cores, load average at
+start and end, date, command line, options) to ``docs/benchmarks-sd.json``; the page
+and the figure are drawn from that JSON only (``benchmarks/sd_page.py``), and
+``tests/test_benchmarks_sd.py`` re-renders the page and checks it.
 
 Families (every instance is solved by every method in this one process):
 
@@ -29,19 +36,23 @@ ratios are taken on the instances both sides ran.
 from __future__ import annotations
 
 import argparse
+import json
 import math
 import os
 import platform
 import statistics
 import sys
 import time
-from dataclasses import dataclass, field
+from dataclasses import asdict, dataclass, field
 from pathlib import Path
 
 import numpy as np
 
 ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))
+sys.path.insert(0, str(ROOT / "benchmarks"))
+
+import sd_page  # noqa: E402  (the page and figure, from the JSON)
 
 from assocopt import AssignmentProblem, Status, solve  # noqa: E402
 from assocopt.io import write_text_atomically  # noqa: E402
@@ -219,9 +230,16 @@ def agrees(a: float | None, b: float | None) -> bool:
 
 
 # ----------------------------------------------------------------------- sections
-def exact_section(instances, solvers, limit, cpsat_limit, log, ref_all=False) -> dict:
+def record(inst: Instance) -> dict:
+    """What the page needs to know about an instance (JSON)."""
+    return {"family": inst.family, "name": inst.name, "size": inst.size,
+            "sizes": list(inst.problem.sizes), "K": int(inst.problem.n_candidates),
+            "optimum": inst.optimum, "peers": inst.peers}
+
+
+def exact_section(instances, solvers, limit, cpsat_limit, log, ref_all=False) -> list:
     """Time to proven optimum, every solver on its instances."""
-    rows = {}
+    rows = []
     for inst in instances:
         res = {}
         for s in solvers:
@@ -235,18 +253,19 @@ def exact_section(instances, solvers, limit, cpsat_limit, log, ref_all=False) ->
             ref = proven[0] if proven else None
         for r in res.values():
             r.info["correct"] = (not r.proven) or ref is None or agrees(r.objective, ref)
-        rows[inst.name] = (inst, res)
+        rows.append(record(inst) | {"reference": ref,
+                                    "results": {s: asdict(r) for s, r in res.items()}})
         log(f"{inst.family:15s} {inst.name:24s} K={inst.problem.n_candidates:7d} " +
             " ".join(f"{s}={r.time:7.3f}s{'' if r.proven else '*'}"
                      f"{'' if r.info['correct'] else '!WRONG'}" for s, r in res.items()))
     return rows
 
 
-def fixed_time_section(instances, solvers, t_fixed, log) -> dict:
-    out = {}
+def fixed_time_section(instances, solvers, t_fixed, log) -> list:
+    out = []
     for inst in instances:
         res = {s: run(inst.problem, s, time_limit=t_fixed) for s in solvers}
-        out[inst.name] = (inst, res)
+        out.append(record(inst) | {"results": {s: asdict(r) for s, r in res.items()}})
         log(f"gap after {t_fixed:g}s on {inst.name}: " +
             " ".join(f"{s}={_pct(r.gap)}" for s, r in res.items()))
     return out
@@ -265,7 +284,8 @@ def plain_section(instances, log) -> list:
             lp = math.ceil(lp - 1e-6)      # integer costs: bounds are rounded up
         r.info["lp_gap"] = (None if lp is None or opt is None
                             else (opt - lp) / max(abs(opt), 1e-12))
-        out.append((inst, r, r.time / it))
+        out.append(record(inst) | {"run": asdict(r), "lp_bound": lp, "optimum_found": opt,
+                                   "per_iteration_s": r.time / it})
         log(f"lagrangian 100 it on {inst.name}: gap {_pct(r.gap)} in {it} it, "
             f"{1e3 * r.time / it:.2f} ms/it, LP gap {_pct(r.info['lp_gap'])}")
     return out
@@ -284,10 +304,11 @@ def latency_section(groups, solvers, log) -> list:
                 sol = solve(p, s)
                 times.append(time.perf_counter() - t0)
                 ok += sol.status is Status.OPTIMAL
-            row[s] = (statistics.median(times), max(times), ok, len(probs))
-        out.append((label, probs[0].n_candidates, row))
+            row[s] = {"median_s": statistics.median(times), "max_s": max(times),
+                      "optimal": ok, "count": len(probs), "times_s": times}
+        out.append({"label": label, "K": int(probs[0].n_candidates), "results": row})
         log(f"latency {label}: " + " ".join(
-            f"{s}={1e3 * v[0]:.2f}ms" for s, v in row.items()))
+            f"{s}={1e3 * v['median_s']:.2f}ms" for s, v in row.items()))
     return out
 
 
@@ -330,34 +351,27 @@ print(json.dumps(rows))
 def lap_section(quick, lapx_path, log) -> list:
     """2-D LAP engines, in a subprocess so that lapx (a side install given by
     ``--lapx-path``) never leaks into the S-D measurements above."""
-    import json
     import subprocess
     env = dict(os.environ)
     paths = [str(ROOT)] + ([lapx_path] if lapx_path else [])
     env["PYTHONPATH"] = os.pathsep.join(paths + [env.get("PYTHONPATH", "")])
     out = subprocess.run([sys.executable, "-c", _LAP_CODE, "1" if quick else "0"],
                          env=env, capture_output=True, text=True, check=True)
-    rows = json.loads(out.stdout)
-    for row in rows:
-        log(f"LAP {row[0]}: scipy {row[1]} assocopt(scipy path) {row[2]} lapx {row[3]}")
+    rows = [{"label": r[0], "scipy_s": r[1], "scipy_path_s": r[2], "lapx_s": r[3]}
+            for r in json.loads(out.stdout)]
+    for r in rows:
+        log(f"LAP {r['label']}: scipy {r['scipy_s']} assocopt(scipy path) "
+            f"{r['scipy_path_s']} lapx {r['lapx_s']}")
     return rows
 
 
 # ----------------------------------------------------------------------- report
 def _pct(g):
-    return "n/a" if g is None else ("inf" if not math.isfinite(g) else f"{100 * g:.3g}%")
+    return sd_page.pct(g)
 
 
-def _fmt_t(r: Run | None) -> str:
-    if r is None:
-        return "-"
-    mark = "" if r.proven else " (not proven)"
-    if not r.info.get("correct", True):
-        mark += " WRONG"
-    return f"{r.time:.3f}{mark}"
-
-
-def machine_info() -> list[str]:
+def environment(argv: list[str]) -> dict:
+    """Machine, versions, load average at the start, date and command line."""
     import importlib.metadata as md
     cpu = platform.processor() or "unknown"
     try:
@@ -367,148 +381,38 @@ def machine_info() -> list[str]:
                 break
     except OSError:
         pass
-    vers = []
-    for d in ("numpy", "scipy", "highspy", "ortools", "lapx", "matplotlib"):
+    vers = {}
+    for d in ("numpy", "scipy", "highspy", "ortools", "lapx", "matplotlib", "numba"):
         try:
-            vers.append(f"{d} {md.version(d)}")
+            vers[d] = md.version(d)
         except md.PackageNotFoundError:
-            vers.append(f"{d} (not installed)")
-    load = os.getloadavg() if hasattr(os, "getloadavg") else ("?",)
-    return [f"- CPU: {cpu}, {os.cpu_count()} logical cores; {platform.platform()}",
-            f"- Python {platform.python_version()}; " + ", ".join(vers),
-            f"- load average at start: {', '.join(f'{v:.2f}' for v in load)}"]
+            vers[d] = None
+    return {"command": "python benchmarks/sd_scaling.py" + "".join(" " + a for a in argv),
+            "date": time.strftime("%Y-%m-%d"), "cpu": cpu, "cores": os.cpu_count(),
+            "platform": platform.platform(), "python": platform.python_version(),
+            "versions": vers, "load_start": [round(x, 2) for x in os.getloadavg()]}
 
 
-def family_table(rows, solvers) -> list[str]:
-    fams: dict = {}
-    for inst, res in rows.values():
-        fams.setdefault((inst.family, inst.size), []).append((inst, res))
-    head = "| family | n | instances | " + " | ".join(
-        f"{s} total s (proven)" for s in solvers) + " |"
-    lines = [head, "|" + "---|" * (3 + len(solvers))]
-    for (fam, n), items in sorted(fams.items()):
-        cells = []
-        for s in solvers:
-            rs = [res[s] for _, res in items if s in res]
-            if not rs:
-                cells.append("-")
-                continue
-            wrong = sum(not r.info.get("correct", True) for r in rs)
-            cells.append(f"{sum(r.time for r in rs):.3f} ({sum(r.proven for r in rs)}/"
-                         f"{len(rs)}){' WRONG ' + str(wrong) if wrong else ''}")
-        lines.append(f"| {fam} | {n} | {len(items)} | " + " | ".join(cells) + " |")
-    return lines
-
-
-def ratio_lines(rows, solvers, base="scipy") -> list[str]:
-    out = []
-    common = [(inst, res) for inst, res in rows.values()
-              if base in res and "lagrangian-exact" in res]
-    if not common:
-        return ["(no instance ran both)"]
-    for s in solvers:
-        if s == base:
-            continue
-        both = [(res[s], res[base]) for _, res in common if s in res]
-        if not both:
-            continue
-        t_s = sum(a.time for a, _ in both)
-        t_b = sum(b.time for _, b in both)
-        ps = sum(a.proven for a, _ in both)
-        pb = sum(b.proven for _, b in both)
-        out.append(f"| {s} | {len(both)} | {t_s:.2f} | {t_b:.2f} | {t_s / t_b:.4f} "
-                   f"(1/{t_b / max(t_s, 1e-9):.1f}) | {ps} | {pb} |")
-    return ["| method | instances | method total s | scipy total s | ratio | method proven "
-            "| scipy proven |", "|---|---|---|---|---|---|---|"] + out
-
-
-def plot(rows, path: Path, solvers) -> bool:
-    try:
-        import matplotlib
-        matplotlib.use("Agg")
-        import matplotlib.pyplot as plt
-    except ImportError:
-        return False
-    fig, axes = plt.subplots(1, 2, figsize=(11, 4.2))
-    for ax, fam in zip(axes, ("grundel", "balas-saltzman")):
-        for s in solvers:
-            pts: dict = {}
-            for inst, res in rows.values():
-                if inst.family == fam and s in res:
-                    pts.setdefault(inst.size, []).append(res[s].time)
-            if pts:
-                xs = sorted(pts)
-                ax.plot(xs, [statistics.median(pts[x]) for x in xs], marker="o", label=s)
-        ax.set_yscale("log")
-        ax.set_xlabel("n (3-AP size)")
-        ax.set_ylabel("time to proven optimum, s (median)")
-        ax.set_title(f"{fam} 3-AP")
-        ax.grid(True, which="both", alpha=0.3)
-    axes[0].legend(fontsize=8)
-    fig.tight_layout()
-    fig.savefig(path, dpi=110)
-    plt.close(fig)
-    return True
-
-
-def targets(rows, ap_rows, other, plain, lat, lapres) -> list[str]:
-    out = []
-    la = [r["lagrangian-exact"] for _, r in ap_rows.values()]
-    if la:
-        common = [r for _, r in ap_rows.values() if "scipy" in r]
-        t_l = sum(r["lagrangian-exact"].time for r in common)
-        t_s = sum(r["scipy"].time for r in common)
-        out.append(f"- 3-AP, all {len(la)} instances proven by `lagrangian-exact`: "
-                   f"{sum(r.proven and r.info.get('correct', True) for r in la)}/{len(la)}; "
-                   f"on the {len(common)} instances scipy also ran, total "
-                   f"{t_l:.2f} s vs {t_s:.2f} s = 1/{t_s / max(t_l, 1e-9):.1f} "
-                   "(target: at most 1/10, goal 1/50).")
-        t_a = sum(r["auto"].time for r in common if "auto" in r)
-        if t_a:
-            out.append(f"- Same instances with `auto` (what `solve` picks): {t_a:.2f} s vs "
-                       f"{t_s:.2f} s = 1/{t_s / max(t_a, 1e-9):.1f}.")
-    cs = [(i, r) for i, r in other.values() if i.family == "crama-spieksma"]
-    if cs:
-        slower = [i.name for i, r in cs if "highs" in r and
-                  r["lagrangian-exact"].time > r["highs"].time]
-        out.append(f"- LP-gap 3-AP: {sum(r['lagrangian-exact'].proven for _, r in cs)}/"
-                   f"{len(cs)} proven; slower than HiGHS alone on "
-                   f"{len(slower)} ({', '.join(slower) or 'none'}).")
-    trk = [(i, r) for i, r, _ in plain if i.family.startswith("tracking")]
-    if trk:
-        worst = max((r.gap or 0.0) for _, r in trk)
-        out.append(f"- Plain `lagrangian`, S-D with dummies, 100 iterations: worst gap "
-                   f"{_pct(worst)} over {len(trk)} instances (target <= 1%).")
-    small = [(label, row["auto"]) for label, _, row in lat if "auto" in row]
-    if small:
-        out.append("- `auto` latency, n <= 10 (target <= 1 ms), median (max) over the "
-                   "draws: " + "; ".join(f"{label}: {1e3 * v[0]:.2f} ({1e3 * v[1]:.1f}) ms"
-                                         for label, v in small) +
-                   f"; median at or below 1 ms in {sum(v[0] <= 1e-3 for _, v in small)} "
-                   f"of {len(small)} groups.")
-    for label, t_sp, t_fb, t_lx in lapres:
-        if t_sp and t_lx:
-            out.append(f"- {label}: lapx {t_sp / t_lx:.2f}x faster than scipy "
-                       "(target >= 2x when installed).")
-        if t_sp and t_fb:
-            out.append(f"- {label}: without lapx {t_fb / t_sp:.3f}x scipy's time "
-                       "(target <= 1.1x).")
-    out.append("- Memory: candidates only (tests/test_lagrangian.py::"
-               "test_memory_follows_candidates_not_sizes solves sizes 3000^4 with "
-               "~13,500 candidates).")
-    return out
-
-
-def write_report(path: Path, parts: list[str]) -> None:
-    path.parent.mkdir(parents=True, exist_ok=True)
-    write_text_atomically(path, "\n".join(parts) + "\n")
+def write_outputs(data: dict, json_path: Path | None, page: Path) -> bool:
+    """The JSON (unless None: --render), the figure and the page; True if plotted."""
+    page.parent.mkdir(parents=True, exist_ok=True)
+    if json_path is not None:
+        write_text_atomically(json_path, json.dumps(data, indent=1, default=float) + "\n")
+    png = page.with_suffix(".png")
+    plotted = sd_page.plot(data, png)
+    data = dict(data, figure=png.name if plotted else None)
+    write_text_atomically(page, sd_page.render(data))
+    return plotted
 
 
 # ----------------------------------------------------------------------- main
 def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     ap.add_argument("--quick", action="store_true", help="small instances only (smoke run)")
-    ap.add_argument("--out", default=str(ROOT / "docs" / "benchmarks-sd.md"))
+    ap.add_argument("--out", default=str(ROOT / "docs" / "benchmarks-sd.md"),
+                    help="the page; the JSON and the figure go beside it (.json, .png)")
+    ap.add_argument("--render", action="store_true",
+                    help="rewrite the page and the figure from the JSON, run nothing")
     ap.add_argument("--ap-dir", default=str(ROOT.parent / "shared" / "ap_instances"))
     ap.add_argument("--time-limit", type=float, default=60.0,
                     help="per-solve limit for the exact methods (s)")
@@ -525,7 +429,13 @@ def main(argv=None) -> int:
     ap.add_argument("--reference-all", action="store_true",
                     help="run scipy (the reference) on all 120 3-AP instances, the other "
                          "peers on the subset (about 17 min instead of 8)")
+    argv = sys.argv[1:] if argv is None else list(argv)
     args = ap.parse_args(argv)
+    page = Path(args.out)
+    json_path = page.with_suffix(".json")
+    if args.render:
+        write_outputs(json.loads(json_path.read_text()), None, page)
+        return 0
     t_start = time.perf_counter()
     lines_log: list[str] = []
 
@@ -536,7 +446,7 @@ def main(argv=None) -> int:
     solvers = [s for s in EXACT if available(s)]
     missing = [s for s in EXACT if s not in solvers]
     rng = np.random.default_rng(args.seed)
-    header = machine_info()
+    env = environment(argv)
     warm_up(solvers + ["lagrangian"])
 
     # 1. shared 3-AP instances
@@ -574,124 +484,16 @@ def main(argv=None) -> int:
     lapres = lap_section(args.quick, args.lapx_path, log)
     total = time.perf_counter() - t_start
 
-    # ------------------------------------------------------------- report
-    out = Path(args.out)
-    out.parent.mkdir(parents=True, exist_ok=True)
-    png = out.with_suffix(".png")
-    plotted = plot(rows, png, solvers)
-    cmd = "python benchmarks/sd_scaling.py" + (" " + " ".join(argv or sys.argv[1:])
-                                               if (argv or sys.argv[1:]) else "")
-    P = ["# S-D assignment at scale: Lagrangian relaxation vs MILP/CP solvers", "",
-         f"Generated by `{cmd}` (one process, {total / 60:.1f} min).  "
-         "Timings are in-process wall-clock seconds of `assocopt.solve` (model building "
-         "included).  This machine has 2 cores that other people's test runs shared "
-         "during the run, so single timings are noisy (see the load averages); ratios "
-         "between methods measured side by side are the robust numbers.", ""]
-    P += ["## What is compared", "",
-          "- `lagrangian`: Lagrangian relaxation of N-2 axes to a 2-D assignment "
-          "(Pattipati et al. 1992, Deb et al. 1997), Polyak subgradient steps, recursive "
-          "2-D recovery plus axis-wise local search; reports bound, objective and gap, "
-          "`OPTIMAL` only with a proof.",
-          "- `lagrangian-exact`: the same ascent, then reduced-cost fixing with the LAP "
-          "duals; the candidates whose bound lies below a threshold T form a *window* "
-          "that holds every solution cheaper than T; windows grow until T reaches the "
-          "incumbent and are solved by the compiled exact-cover search (numba, up to "
-          "100,000 nodes), then CP-SAT (integer costs, <= 1,500 candidates, 1 s budget) "
-          "or HiGHS (stopped at the proven bound).  Proven optimum, no tolerance beyond "
-          "floating-point round-off.",
-          "- `auto`: what `solve(p)` picks: `bnb` up to 10,000 candidates, else "
-          "`lagrangian-exact`.  `bnb` runs in one compiled call: the same relaxation "
-          "with a dense Hungarian method, N = 3 primal recovery each iteration, then a "
-          "depth-first exact-cover branch and bound on the reduced costs (falls back "
-          "to `lagrangian-exact` after 200,000 nodes).",
-          "- `highs`: HiGHS MIP through highspy on the full ILP; `scipy`: "
-          "scipy.optimize.milp (HiGHS inside scipy); `ortools-cpsat`: CP-SAT on the "
-          "exact-cover model (float costs scaled to integers: `FEASIBLE` only).", "",
-          "Why it is fast: the Lagrangian bound is the LP bound at the cost of a few "
-          "hundred 2-D assignments, and it prices every candidate: the reduced costs cut "
-          "almost every branch of an exact-cover search, which in compiled code visits a "
-          "node in about a microsecond, so the windows that HiGHS needed seconds for are "
-          "settled in milliseconds.  The MILP solvers spend most of their time in "
-          "presolve, the root LP of the full model and heuristics.", ""]
-    P += ["## Machine", ""] + header + [
-        f"- load average at end: {', '.join(f'{v:.2f}' for v in os.getloadavg())}",
-        f"- per-solve time limit {args.time_limit:g} s (CP-SAT: {args.cpsat_limit:g} s); "
-        f"runs stopped by it count with the limit as their time; not installed / "
-        f"not registered: {', '.join(missing) or 'none'}", ""]
-    ap_rows = {k: v for k, v in rows.items() if v[0].family in ("grundel", "balas-saltzman")}
-    P += ["## Time to proven optimum", "",
-          "Total seconds per family and size; `(p/k)`: proven optimal in p of k runs. "
-          "Peers (HiGHS, scipy, CP-SAT) run on every 3-AP instance with n <= 10 and on "
-          "20% of each larger size (Grundel instances 1-2 of 10, Balas-Saltzman 1 of 5)" +
-          (" (scipy on all 120: `--reference-all`)" if ref_all else "") +
-          "; `auto` and `lagrangian-exact` on all 120.  Every "
-          "proven objective is checked against the recorded optimum (or the other "
-          "methods): a mismatch would be flagged WRONG.", ""]
-    P += family_table(rows, solvers) + [""]
-    la = [r["lagrangian-exact"] for _, r in ap_rows.values()]
-    if la:
-        P += [f"`lagrangian-exact` on all {len(la)} shared 3-AP instances: "
-              f"{sum(r.proven for r in la)} proven optimal, "
-              f"{sum(not r.info.get('correct', True) for r in la)} wrong, "
-              f"total {sum(r.time for r in la):.2f} s, slowest "
-              f"{max(r.time for r in la):.2f} s.", ""]
-    P += ["### Ratios against scipy.optimize.milp (same instances, same run)", "",
-          "Shared 3-AP instances:", ""] + ratio_lines(ap_rows, solvers) + [""]
-    other = {k: v for k, v in rows.items() if k not in ap_rows}
-    P += ["LP-gap 3-AP and tracking S-D instances:", ""] + ratio_lines(other, solvers) + [""]
-    if plotted:
-        P += [f"![time to proven optimum versus n]({png.name})", ""]
-    P += ["## Gap after a fixed time", "",
-          f"Each method stopped after {args.fixed_time:g} s (`time_limit`); relative gap "
-          "`(objective - bound) / |objective|` (n/a: no bound or no solution).", "",
-          "| instance | K | " + " | ".join(["lagrangian"] + solvers) + " |",
-          "|---|---|" + "---|" * (len(solvers) + 1)]
-    for name, (inst, res) in fixed.items():
-        P.append(f"| {name} | {inst.problem.n_candidates} | " +
-                 " | ".join(_pct(res[s].gap) for s in ["lagrangian"] + solvers) + " |")
-    P += ["", "## Plain `lagrangian`: gap after 100 iterations", "",
-          "`solve(p, 'lagrangian', max_iter=100, gap_tol=0)`; each iteration is one pass "
-          "over the candidates, one 2-D assignment and the primal recovery.  `LP gap`: "
-          "the integrality gap `(optimum - LP) / |optimum|`, with the LP bound rounded up "
-          "for integer costs (as every bound is then).  The Lagrangian bound never "
-          "exceeds the LP bound, so no Lagrangian method can certify a gap below it: the "
-          "1% target is about S-D problems with dummies (tracking), where the LP is "
-          "nearly integral; on the LP-gap 3-AP instances the gap shown is at least the "
-          "LP gap by construction.", "",
-          "| instance | sizes | K | gap | LP gap | iterations | ms / iteration |",
-          "|---|---|---|---|---|---|---|"]
-    for inst, r, per in plain:
-        P.append(f"| {inst.name} | {inst.problem.sizes} | {inst.problem.n_candidates} | "
-                 f"{_pct(r.gap)} | {_pct(r.info.get('lp_gap'))} | "
-                 f"{r.info.get('iterations')} | {1e3 * per:.2f} |")
-    P += ["", "## Small problems: in-process latency of `solver=\"auto\"`", "",
-          "Median (max) milliseconds per `solve()` call over the listed problems (distinct "
-          "random draws), after warm-up; `auto` picks `bnb` for these (N >= 3, at most "
-          "10,000 candidates).", "",
-          "| problems | K (first) | " + " | ".join(lat[0][2]) + " |" if lat else "",
-          "|---|---|" + "---|" * (len(lat[0][2]) if lat else 0)]
-    for label, K, row in lat:
-        P.append(f"| {label} | {K} | " + " | ".join(
-            f"{1e3 * v[0]:.2f} ({1e3 * v[1]:.1f}), {v[2]}/{v[3]} optimal"
-            for v in row.values()) + " |")
-    P += ["", "## 2-D assignment engines", "",
-          "Best of 7 interleaved repeats, in a separate process (lapx from `--lapx-path` "
-          "only there).  "
-          "`assocopt scipy path`: `linear_assignment(C, 'scipy')`, what runs when lapx "
-          "is not installed; `lapx`: `linear_assignment(C, 'lapx')` (lapx's `lapjvh`), "
-          "what `auto` and the `lapjv` back end use when it is.", "",
-          "| problem | scipy LSA s | assocopt scipy path s | lapx s | scipy / lapx | "
-          "scipy path / scipy |", "|---|---|---|---|---|---|"]
-    for label, t_sp, t_fb, t_lx in lapres:
-        cells = ["-" if v is None else f"{v:.4f}" for v in (t_sp, t_fb, t_lx)]
-        r1 = f"{t_sp / t_lx:.2f}x" if t_sp and t_lx else "-"
-        r2 = f"{t_fb / t_sp:.3f}" if t_sp and t_fb else "-"
-        P.append(f"| {label} | " + " | ".join(cells) + f" | {r1} | {r2} |")
-    P += ["", "## Targets of the issue, as measured in this run", ""] + targets(
-        rows, ap_rows, other, plain, lat, lapres) + [""]
-    P += ["", "## Log", "", "```"] + lines_log + ["```"]
-    write_report(out, P)
-    print(f"wrote {out}" + (f" and {png}" if plotted else ""), flush=True)
+    env["minutes"] = (time.perf_counter() - t_start) / 60
+    env["load_end"] = [round(x, 2) for x in os.getloadavg()]
+    data = {"environment": env,
+            "options": {k: v for k, v in vars(args).items() if k not in ("out", "render")}
+            | {"solvers": solvers, "missing": missing, "reference_all": ref_all},
+            "exact": rows, "fixed": fixed, "plain": plain, "latency": lat, "lap": lapres,
+            "log": lines_log}
+    plotted = write_outputs(data, json_path, page)
+    print(f"wrote {json_path}, {page}" + (f" and {page.with_suffix('.png')}" if plotted
+                                            else ""), flush=True)
     return 0
 
 
