@@ -482,7 +482,6 @@ def main(argv=None) -> int:
     lat = latency_section(groups, ["auto"] + [s for s in ("lagrangian-exact", "highs", "scipy")
                                               if s in solvers], log)
     lapres = lap_section(args.quick, args.lapx_path, log)
-    total = time.perf_counter() - t_start
 
     env["minutes"] = (time.perf_counter() - t_start) / 60
     env["load_end"] = [round(x, 2) for x in os.getloadavg()]
