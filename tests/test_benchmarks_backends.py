@@ -64,9 +64,10 @@ def test_every_proven_objective_is_the_recorded_optimum():
             assert res["time"] == statistics.median(res["times"])
 
 
-def test_our_exact_methods_prove_every_instance():
+def test_the_default_and_the_lagrangian_exact_method_prove_every_instance():
+    """What README.md and the S-D page say of them (``bnb`` alone may hit the limit)."""
     for row in _data()["records"]:
-        for name in ("lagrangian-exact", "bnb", "auto"):
+        for name in ("lagrangian-exact", "auto"):
             if name in row["results"]:
                 assert row["results"][name]["correct"], (row["instance"], name)
 
