@@ -179,9 +179,14 @@ def readme_figure(data: dict, instance: str = "ap3.50.1.txt",
                   method: str = "lagrangian-exact") -> str:
     """The README's sentence on the largest Grundel instance, from the JSON."""
     row = next(r for r in data["records"] if r["instance"].endswith("/" + instance))
-    t, ref = row["results"][method]["time"], row["results"][REFERENCE]["time"]
-    return (f"`{method}` proves Grundel n = {row['n']} optimal in {t:.2f} s where "
-            f"scipy milp takes {ref:.1f} s")
+    ours, ref = row["results"][method], row["results"][REFERENCE]
+    if not ours["correct"]:
+        return f"`{method}` does not prove Grundel n = {row['n']} optimal ({ours['status']})"
+    head = f"`{method}` proves Grundel n = {row['n']} optimal in {ours['time']:.2f} s where "
+    if ref["correct"]:
+        return head + f"scipy milp takes {ref['time']:.1f} s"
+    return head + (f"scipy milp stops at the {data['options']['time_limit']:g} s time limit "
+                   f"without a proof ({ref['time']:.1f} s, {ref['status']})")
 
 
 def environment(argv: list[str], solvers: list[str]) -> dict:
