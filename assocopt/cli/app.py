@@ -14,6 +14,7 @@ from ..errors import AssocoptError
 from .common import (EXIT_BAD_INPUT, EXIT_BROKEN_PIPE, EXIT_INTERNAL, EXIT_INTERRUPTED,
                      _error, _one_line, _os_message, _UsageError)
 from .parser import _build_parser
+from .watchdog import arm
 from .solve_cmds import _cmd_compare, _cmd_solve, _cmd_solvers, _cmd_validate
 from .workflow_cmds import (_cmd_convert, _cmd_export, _cmd_generate, _cmd_instances,
                             _cmd_models, _cmd_reproduce)
@@ -80,6 +81,7 @@ def _exit_now_if_solver_threads(as_program: bool) -> None:
 def main(argv: Sequence[str] | None = None) -> int:
     """Run the command line; returns the exit code (see :mod:`assocopt.cli`)."""
     out, err = sys.stdout, sys.stderr
+    disarm = arm(EXIT_INTERRUPTED) if argv is None else (lambda: None)
     try:
         parser = _build_parser()
         args = parser.parse_args(list(sys.argv[1:] if argv is None else argv))
@@ -111,4 +113,6 @@ def main(argv: Sequence[str] | None = None) -> int:
         _error(err, f"internal error ({type(exc).__name__}: {_one_line(str(exc))}); "
                     "this is a bug in assocopt or a back end, please report it")
         return EXIT_INTERNAL
+    finally:
+        disarm()
 

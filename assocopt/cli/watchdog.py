@@ -1,0 +1,56 @@
+"""A last resort for Ctrl-C at the command line: leave within seconds even when the
+interrupt is lost.
+
+Python delivers SIGINT as a ``KeyboardInterrupt`` at the next bytecode of the main
+thread; when that bytecode belongs to a finaliser (``__del__``, a weakref callback run
+by the garbage collector) the exception is printed as "ignored" and the solve goes on.
+:func:`arm` installs a handler that raises ``KeyboardInterrupt`` as usual (so the stack
+unwinds and temporary files are removed) and also starts a daemon thread that ends the
+process with exit code 130 if it is still running :data:`GRACE` seconds later.  Only
+the program (``assocopt ...``) arms it, never a caller of :func:`assocopt.cli.main`.
+"""
+
+from __future__ import annotations
+
+import os
+import signal
+import sys
+import threading
+from typing import Any, Callable
+
+__all__ = ["arm", "GRACE"]
+
+#: Seconds between the first Ctrl-C and the forced exit.
+GRACE = 5.0
+
+
+def arm(exit_code: int) -> Callable[[], None]:
+    """Install the SIGINT handler (main thread only); returns the function that puts
+    the previous handler back."""
+    if threading.current_thread() is not threading.main_thread() or \
+            signal.getsignal(signal.SIGINT) is not signal.default_int_handler:
+        return lambda: None       # a thread, or SIGINT ignored / taken over by the caller
+    fired = threading.Event()
+
+    def leave_later() -> None:
+        threading.Event().wait(GRACE)
+        for stream in (sys.stdout, sys.stderr):
+            try:
+                stream.flush()
+            except (OSError, ValueError):
+                pass
+        try:
+            os.write(2, b"assocopt: interrupted\n")
+        except OSError:
+            pass
+        os._exit(exit_code)
+
+    def on_sigint(signum: int, frame: Any) -> None:
+        if not fired.is_set():
+            fired.set()
+            threading.Thread(target=leave_later, name="assocopt-watchdog",
+                             daemon=True).start()
+        raise KeyboardInterrupt
+
+    old = signal.signal(signal.SIGINT, on_sigint)
+    return lambda: signal.signal(signal.SIGINT, old)

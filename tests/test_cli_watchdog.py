@@ -1,0 +1,55 @@
+"""Ctrl-C at the command line ends the process even when the KeyboardInterrupt is lost
+(raised inside a finaliser and printed as "ignored"): the watchdog exits with 130."""
+
+from __future__ import annotations
+
+import os
+import signal
+import subprocess
+import sys
+from pathlib import Path
+
+ROOT = Path(__file__).resolve().parents[1]
+
+CHILD = """
+import sys, time
+from assocopt.cli import watchdog
+watchdog.GRACE = 0.3
+watchdog.arm(130)
+print("ready", flush=True)
+try:
+    time.sleep(30)
+except KeyboardInterrupt:
+    pass                      # the interrupt lost, as in a finaliser
+time.sleep(60)
+print("still running", flush=True)
+"""
+
+
+def _run_child(code: str) -> subprocess.Popen:
+    env = dict(os.environ, PYTHONPATH=str(ROOT))
+    return subprocess.Popen([sys.executable, "-c", code], env=env, text=True,
+                            stdout=subprocess.PIPE, stderr=subprocess.PIPE)
+
+
+def test_a_lost_interrupt_still_ends_the_program():
+    proc = _run_child(CHILD)
+    try:
+        assert proc.stdout.readline().strip() == "ready"
+        proc.send_signal(signal.SIGINT)
+        out, err = proc.communicate(timeout=50)
+        assert proc.returncode == 130, (out, err)
+        assert "still running" not in out and "assocopt: interrupted" in err
+    finally:
+        proc.kill()
+
+
+def test_an_ignored_sigint_is_left_alone():
+    """Started with SIGINT ignored (a background job), the program keeps it ignored."""
+    code = ("import signal; signal.signal(signal.SIGINT, signal.SIG_IGN)\n"
+            "from assocopt.cli import watchdog\n"
+            "watchdog.arm(130)\n"
+            "print(signal.getsignal(signal.SIGINT) is signal.SIG_IGN)")
+    proc = _run_child(code)
+    out, _ = proc.communicate(timeout=50)
+    assert out.strip() == "True"
