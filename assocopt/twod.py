@@ -151,12 +151,10 @@ class Dense2D:
     ``miss_flags``: ``(all rm finite, all cm finite)``; ``amax``: upper bounds on the
     largest finite magnitudes of ``C``, ``rm``, ``cm`` where known (see
     :meth:`cost_bound`).
-    Read-only by convention (a plain class with slots: built once per scan, where a
-    frozen dataclass's ``__init__`` and an instance dict cost).
+    Read-only by convention (a plain class with slots: built once per scan).
     """
 
-    __slots__ = ("C", "rm", "cm", "slack", "all_finite", "n_pairs", "miss_index",
-                 "miss_flags", "amax", "_rank")
+    __slots__ = tuple("C rm cm slack all_finite n_pairs miss_index miss_flags amax _rank".split())
 
     def __init__(self, C: np.ndarray, rm: np.ndarray, cm: np.ndarray, slack: bool,
                  all_finite: bool, n_pairs: int,
