@@ -31,6 +31,7 @@ import time
 import numpy as np
 from scipy.optimize import linear_sum_assignment as _lsa
 
+from ..scaling import SCALE_ABOVE      # beyond it the general route answers
 from ..solution import Solution, Status
 from ..twod import Checked
 from ..twod_tables import _index_set, _pair_base, _row_offsets, _tuple_table
@@ -41,8 +42,6 @@ __all__ = ["solve_direct", "SMALL"]
 
 #: Problems with misses and at most this many rows + columns are split on lists.
 SMALL = 64
-#: Costs beyond this magnitude go to the general route (assocopt.scaling.SCALE_ABOVE).
-_SCALE_ABOVE = 2.0 ** 50
 _NAME = "scipy-lsa"
 _MESSAGE = "scipy-lsa: optimal"
 
@@ -52,7 +51,7 @@ def solve_direct(problem, d, t0: float) -> Solution | None:
     when the general route must answer.  ``t0``: when :func:`assocopt.solve` began."""
     C = d.C
     n1, n2 = C.shape
-    if n1 == 0 or n2 == 0 or d.cost_bound() > _SCALE_ABOVE:
+    if n1 == 0 or n2 == 0 or d.cost_bound() > SCALE_ABOVE:
         return None
     t1 = time.perf_counter()
     try:
