@@ -1,5 +1,5 @@
 """The shape of the library: the core never imports tracking or paper code, modules stay
-small, old import paths keep working, and the project cites no file it does not ship.
+small, and the project cites no file it does not ship.
 
 Layers, lowest first: the core (everything under ``assocopt/`` not named below),
 ``assocopt.tracking`` (may import the core), ``assocopt.experiments`` (the core only),
@@ -10,7 +10,6 @@ resolved, so the check covers ``from ..tracking import x`` as well.
 from __future__ import annotations
 
 import ast
-import importlib
 import re
 from pathlib import Path
 
@@ -21,33 +20,12 @@ from conftest import fresh_python
 ROOT = Path(__file__).resolve().parents[1]
 PKG = ROOT / "assocopt"
 
-#: Old public paths kept as re-exporting shims: module -> where the code lives now.
-SHIMS = {
-    "assocopt.localise": "assocopt.tracking.localisation",
-    "assocopt.costs": "assocopt.tracking.costs",
-    "assocopt.belief": "assocopt.tracking.belief",
-    "assocopt.group_matching": "assocopt.tracking.group_matching",
-    "assocopt.decide": "assocopt.tracking.decide",
-    "assocopt.scenarios": "assocopt.tracking.scenarios",
-    "assocopt.reproduce.sdlp": "assocopt.lp_fixing",
-}
-#: Shim submodules that must be the very module objects of the new place.
-SHIM_SUBMODULES = {
-    "assocopt.costs.sd_builder": "assocopt.tracking.costs.sd_builder",
-    "assocopt.costs.pattipati": "assocopt.tracking.costs.pattipati",
-    "assocopt.costs.divergence": "assocopt.tracking.costs.kld",
-    "assocopt.belief.mass": "assocopt.tracking.belief.mass",
-    "assocopt.decide.truncation": "assocopt.tracking.decide.truncation",
-    "assocopt.decide.md2da": "assocopt.tracking.decide.md2da",
-    "assocopt.scenarios.lu2013": "assocopt.tracking.scenarios.lu2013",
-    "assocopt.scenarios.zhang2009": "assocopt.tracking.scenarios.zhang2009",
-}
 #: Upper layers, each with the layers it must not import.
 UPPER = ("assocopt.tracking", "assocopt.experiments", "assocopt.reproduce")
 FORBIDDEN = {
-    "core": UPPER + tuple(SHIMS),
+    "core": UPPER,
     "assocopt.tracking": ("assocopt.experiments", "assocopt.reproduce"),
-    "assocopt.experiments": ("assocopt.tracking", "assocopt.reproduce") + tuple(SHIMS),
+    "assocopt.experiments": ("assocopt.tracking", "assocopt.reproduce"),
 }
 #: The one place the core names the tracking layer: the cost builders of scenario
 #: models, looked up by name like a plug-in (assocopt/models.py, COST_LAYER).
@@ -67,10 +45,6 @@ def _module_name(path: Path) -> str:
 
 def _modules() -> dict[str, Path]:
     return {_module_name(p): p for p in sorted(PKG.rglob("*.py"))}
-
-
-def _shim_files() -> set[str]:
-    return set(SHIMS) | {"assocopt.export"}
 
 
 def _layer(name: str) -> str:
@@ -110,19 +84,17 @@ def test_the_import_resolver_sees_relative_and_absolute_imports(tmp_path):
     pkg.mkdir(parents=True)
     f = pkg / "bad.py"
     f.write_text("from ..tracking.costs import COSTS\nimport assocopt.reproduce.lu2013\n"
-                 "from .. import experiments\ndef f():\n    from ..localise import angles\n")
+                 "from .. import experiments\ndef f():\n    from ..tracking.localisation import angles\n")
     found = [m for _, m in _imports("assocopt.solvers.bad", f)]
     assert _hits(found[0], FORBIDDEN["core"])
     assert "assocopt.reproduce.lu2013" in found
     assert "assocopt.experiments" in found
-    assert "assocopt.localise" in found
+    assert "assocopt.tracking.localisation" in found
 
 
 def test_layers_import_only_downwards():
     bad = []
     for name, path in _modules().items():
-        if name in _shim_files() or name == "assocopt._moved":
-            continue
         forbidden = FORBIDDEN.get(_layer(name), ())
         for line, mod in _imports(name, path):
             if _hits(mod, forbidden):
@@ -135,7 +107,7 @@ def test_the_core_names_upper_layers_only_at_declared_plugin_points():
     pattern = re.compile(r"[\"']assocopt\.(tracking|experiments|reproduce)[\w.]*[\"']")
     bad = []
     for name, path in _modules().items():
-        if _layer(name) != "core" or name in _shim_files():
+        if _layer(name) != "core":
             continue
         for m in pattern.finditer(path.read_text(encoding="utf-8")):
             if m.group(0).strip("'\"") not in PLUGIN_POINTS.get(name, set()):
@@ -154,65 +126,12 @@ def test_no_module_is_over_the_size_limit():
     assert not long, f"modules over {MAX_LINES} lines (split them by concept): {long}"
 
 
-@pytest.mark.parametrize("old,new", sorted(SHIMS.items()))
-def test_shims_hand_out_the_new_objects(old, new):
-    shim, mod = importlib.import_module(old), importlib.import_module(new)
-    names = getattr(mod, "__all__", None) or [n for n in vars(mod) if not n.startswith("_")]
-    assert names and all(getattr(shim, n) is getattr(mod, n) for n in names)
-    private = [n for n in vars(mod) if n.startswith("_") and not n.startswith("__")]
-    assert all(getattr(shim, n) is getattr(mod, n) for n in private)     # forwarded
-    assert not hasattr(shim, "__path__") or shim.__path__ != getattr(mod, "__path__", None)
-
-
-@pytest.mark.parametrize("old,new", sorted(SHIM_SUBMODULES.items()))
-def test_old_submodule_paths_are_the_new_modules(old, new):
-    assert importlib.import_module(old) is importlib.import_module(new)
-
-
-def test_shims_are_modules_of_their_own_file():
-    """Tools that import a file by path (pytest --doctest-modules) find what they expect."""
-    for name in sorted(_shim_files()):
-        mod = importlib.import_module(name)
-        assert Path(mod.__file__).resolve() == _modules()[name].resolve(), name
-
-
-def test_old_import_paths_keep_their_names():
-    from assocopt.belief import MassFunction
-    from assocopt.costs import build_problem
-    from assocopt.costs.divergence import kld_exact
-    from assocopt.export import convert, export_model, solve_model_file, write_public
-    from assocopt.localise import localise, pseudo_measurements, wrap_angle
-    from assocopt.reproduce.sdlp import lp_relaxation, solve_with_fixing
-    from assocopt.scenarios.lu2013 import Lu2013
-    from assocopt.tracking.belief import MassFunction as M2
-    from assocopt.tracking.scenarios.lu2013 import Lu2013 as L2
-    from assocopt import io
-
-    assert MassFunction is M2 and Lu2013 is L2
-    assert export_model is io.export_model and convert is io.convert
-    assert write_public is io.write_public and solve_model_file is io.solve_model_file
-    for f in (build_problem, kld_exact, localise, pseudo_measurements, wrap_angle,
-              lp_relaxation, solve_with_fixing):
-        assert callable(f)
-
-
 def test_each_concept_is_found_by_file_name():
     for rel in ("formulation.py", "solvers/highs.py", "tracking/costs/kld.py",
                 "tracking/scenarios/lu2013.py", "lp_fixing.py", "io/mps_lp.py",
                 "tracking/localisation/estimate.py", "experiments/store.py",
                 "reproduce/lu2013/__init__.py", "reproduce/zhang2009/__init__.py"):
         assert (PKG / rel).is_file(), rel
-
-
-def test_shims_are_minimal():
-    """A shim re-exports and documents where the code lives; it holds no logic."""
-    for name in sorted(_shim_files()):
-        path = _modules()[name]
-        tree = ast.parse(path.read_text(encoding="utf-8"))
-        assert ast.get_docstring(tree) and "Moved" in ast.get_docstring(tree), name
-        for node in tree.body[1:]:
-            assert isinstance(node, (ast.ImportFrom, ast.Import, ast.Assign)), \
-                f"{name}: a shim holds only imports and the reexport call"
 
 
 # ----------------------------------------------------------------- self-contained docs

@@ -307,7 +307,7 @@ def test_expected_matchings_against_enumeration():
 
 
 def test_covariance_scale_is_a_real_parameter():
-    from assocopt.scenarios.zhang2009 import Zhang2009
+    from assocopt.tracking.scenarios.zhang2009 import Zhang2009
     a = Zhang2009(f=0.3, p_d=1.0).simulate(np.random.default_rng(4))
     b = Zhang2009(f=0.3, p_d=1.0, covariance_scale=4.0).simulate(np.random.default_rng(4))
     assert np.allclose(a.observations.positions, b.observations.positions)

@@ -2,7 +2,7 @@
 
 Every observation ``z = {p, a}`` has a 2-D position ``p`` with its noise covariance
 and an attribute BBA ``a`` on the type frame (a mass vector of length ``2**T``,
-see :mod:`assocopt.belief`).  For every pair of observations the pipeline is
+see :mod:`assocopt.tracking.belief`).  For every pair of observations the pipeline is
 
 1. position belief on ``{M, Mbar}`` (eqs. 1-2, the chi-square(2) p-value):
    ``m^p(M) = exp(-d^2 / 2)`` with ``d^2`` the squared Mahalanobis distance under
@@ -15,7 +15,7 @@ see :mod:`assocopt.belief`).  For every pair of observations the pipeline is
    ``pi = w_p m^p(M) + w_a m^a(M)`` on the undiscounted (1) and (5).
 
 Everything is computed for all pairs at once with the stacked-vector operations of
-:mod:`assocopt.belief` (closed forms on the 2-element frame are the tests' oracle).
+:mod:`assocopt.tracking.belief` (closed forms on the 2-element frame are the tests' oracle).
 
 This module also holds the relation bookkeeping shared by the decision rules
 (:class:`Relations`) and the paper's metric, :func:`correct_match_rate`.

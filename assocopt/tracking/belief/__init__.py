@@ -14,7 +14,7 @@ Two layers:
   element names.
 * ``*_vectors`` / ``*_matrix`` functions -- the same operations on stacked mass
   vectors ``(..., 2**n)`` (numpy broadcasting), used to compute matching measures
-  for every observation pair in bulk (:mod:`assocopt.group_matching`).
+  for every observation pair in bulk (:mod:`assocopt.tracking.group_matching`).
 
 Rules (paper 000, docs/papers/zhang2009.md):
 
@@ -42,7 +42,7 @@ True
 """
 
 # The implementation is split by concern (each module's docstring says what it
-# holds); this package re-exports the public names so that ``assocopt.belief.X``
+# holds); this package re-exports the public names so that ``assocopt.tracking.belief.X``
 # works for every ``X`` in ``__all__``.
 from .combination import (conflict, conflict_matrix, conflict_vectors,  # noqa: F401
                           conjunctive, conjunctive_vectors, dempster, discount,

@@ -2,9 +2,9 @@
 
 A subset of an ``n``-element frame is the integer with bit ``k`` set when element
 ``k`` is in it, and a mass function is a float vector of length ``size = 2**n``
-indexed by that integer (see :mod:`assocopt.belief`).  The combination rules and
-conflict measures in :mod:`assocopt.belief.combination` and
-:mod:`assocopt.belief.zhang` are vectorised over these read-only ``size``-indexed
+indexed by that integer (see :mod:`assocopt.tracking.belief`).  The combination rules and
+conflict measures in :mod:`assocopt.tracking.belief.combination` and
+:mod:`assocopt.tracking.belief.zhang` are vectorised over these read-only ``size``-indexed
 tables (popcounts, pairwise intersections, overlap weights, pignistic
 redistribution), computed once per frame size and shared.  Private to the package.
 """

@@ -2,10 +2,10 @@
 
 Smets' unnormalised conjunctive rule, the traditional conflict ``K0`` (eq. 3),
 Dempster's rule, Shafer's discounting (eqs. 7-9) and the pignistic transform --
-one :class:`~assocopt.belief.mass.MassFunction` at a time and, as ``*_vectors`` /
+one :class:`~assocopt.tracking.belief.mass.MassFunction` at a time and, as ``*_vectors`` /
 ``*_matrix`` functions, on stacked mass vectors in bulk.  The pairwise kernels
 here (:func:`_combine_pair`, :func:`_combine_stacked`) also serve paper 000's
-weighted rule in :mod:`assocopt.belief.zhang`.
+weighted rule in :mod:`assocopt.tracking.belief.zhang`.
 """
 
 from __future__ import annotations

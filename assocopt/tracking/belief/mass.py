@@ -4,7 +4,7 @@
 bitmask-indexed vector), the package's exceptions and tolerances, and the
 validation helpers shared by the operations: :func:`check_vectors` for stacked
 vectors, frame and mass checks, and re-indexing a mass function onto another
-ordering of the same frame.  Everything else in :mod:`assocopt.belief` builds on
+ordering of the same frame.  Everything else in :mod:`assocopt.tracking.belief` builds on
 this module; it depends on nothing else in the package.
 """
 

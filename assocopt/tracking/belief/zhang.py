@@ -5,9 +5,9 @@
 that conflict: eq. (11) as printed says K^a, which breaks the sum to 1), for one pair
 of mass functions and, as ``*_vectors``
 / ``*_matrix`` functions, for stacked mass vectors in bulk.  Kept apart from the
-classical rules in :mod:`assocopt.belief.combination`, whose kernels it reuses.
+classical rules in :mod:`assocopt.tracking.belief.combination`, whose kernels it reuses.
 (The module is not called ``conflict`` so that it cannot shadow the
-:func:`assocopt.belief.conflict` function as a package attribute.)
+:func:`assocopt.tracking.belief.conflict` function as a package attribute.)
 """
 
 from __future__ import annotations

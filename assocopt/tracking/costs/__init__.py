@@ -1,6 +1,6 @@
 """Cost builders: paper 002's Pattipati, KLD and SKLD costs (printed, exact, joint).
 
-See :mod:`assocopt.costs.sd_builder` for the pipeline and :data:`COSTS` for the names;
+See :mod:`assocopt.tracking.costs.sd_builder` for the pipeline and :data:`COSTS` for the names;
 :mod:`.kinematic` has the Mahalanobis and log-likelihood-ratio costs of gated
 track-measurement pairs.
 """

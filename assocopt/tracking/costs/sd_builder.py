@@ -321,7 +321,7 @@ def build_costs(scan: Scan, methods: Sequence[str] = tuple(COSTS), *, localiser:
 
     Examples
     --------
-    >>> from assocopt.scenarios.lu2013 import Lu2013
+    >>> from assocopt.tracking.scenarios.lu2013 import Lu2013
     >>> scan, truth = Lu2013(n_targets=2, d=1.0).simulate(np.random.default_rng(0))
     >>> c = build_costs(scan, ["pattipati", "skld-exact"])
     >>> c["pattipati"].tuples.shape, bool(np.isfinite(c["skld-exact"].total).all())

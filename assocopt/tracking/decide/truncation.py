@@ -15,7 +15,7 @@ C. **Fine truncation** -- the paper's Steps 1-2 on each segment, literally, with
    options (:class:`TruncationOptions`).
 
 Every observation ends in exactly one relation (matched pair or isolated): the
-result is a :class:`~assocopt.group_matching.Relations`, which checks it.
+result is a :class:`~assocopt.tracking.group_matching.Relations`, which checks it.
 
 A derived property (D, checked by the tests on random inputs under every
 combination of options): with undecided nodes isolated at the end, Step C's
