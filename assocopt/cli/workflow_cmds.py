@@ -9,6 +9,7 @@ the functions, as before the split.
 from __future__ import annotations
 
 import argparse
+import functools
 import json
 import sys
 from pathlib import Path
@@ -75,10 +76,13 @@ def _cmd_generate(args: argparse.Namespace, out: TextIO, err: TextIO) -> int:
 
 
 def _cmd_convert(args: argparse.Namespace, out: TextIO, err: TextIO) -> int:
+    from ..generate import prove_optimum
     from ..io.convert import convert
 
+    prove = functools.partial(prove_optimum, time_limit=args.time_limit) if args.prove \
+        else None
     info = convert(args.src, args.dst, from_format=args.format, to_format=args.to_format,
-                   instance=args.instance, prove=args.prove, time_limit=args.time_limit)
+                   instance=args.instance, prove=prove)
     opt = "" if info["optimum"] is None else f"; optimum {_num(info['optimum'])}"
     print(f"wrote {', '.join(info['written'])} ({info['format']} format): {info['name']}, "
           f"sizes {'x'.join(map(str, info['sizes']))}{opt}", file=out)

@@ -6,7 +6,7 @@ import math
 import os
 import re
 from pathlib import Path
-from typing import Any
+from typing import Any, Callable
 
 from ..errors import AssocoptError
 from ..problem import AssignmentProblem
@@ -34,15 +34,17 @@ def output_format(path: str | os.PathLike[str]) -> str | None:
 
 def convert(src: str | os.PathLike[str], dst: str | os.PathLike[str], *,
             from_format: str = "auto", to_format: str | None = None, instance: Any = None,
-            prove: bool = False, time_limit: float | None = None) -> dict[str, Any]:
+            prove: Callable[[AssignmentProblem], tuple[float, str]] | None = None
+            ) -> dict[str, Any]:
     """Read ``src`` in any supported format and write ``dst``.
 
     ``to_format`` defaults to the one :func:`output_format` infers from ``dst``.
     Converting to JSON keeps the recorded optimum and its source and adds a
-    description naming the source file; ``prove=True`` proves the optimum with HiGHS
-    (:func:`assocopt.generate.prove_optimum`) and records it.  Returns a summary.
+    description naming the source file.  ``prove``, when given, proves the optimum of
+    the problem read and returns it with how it was proven (``assocopt convert
+    --prove`` passes :func:`assocopt.generate.prove_optimum`, HiGHS); the result is
+    checked against a recorded optimum and recorded.  Returns a summary.
     """
-    from ..generate import prove_optimum
     from .detect import read_instance
     from .writers import write_instance
 
@@ -55,8 +57,8 @@ def convert(src: str | os.PathLike[str], dst: str | os.PathLike[str], *,
     problem = read_instance(src, format=from_format, instance=instance)
     optimum = problem.optimum
     source = problem.meta.get("optimum_source")
-    if prove:
-        proven, how = prove_optimum(problem, time_limit=time_limit)
+    if prove is not None:
+        proven, how = prove(problem)
         if optimum is not None and not math.isclose(proven, optimum, rel_tol=1e-9,
                                                     abs_tol=1e-9):
             raise AssocoptError(f"{src}: recorded optimum {optimum:g} but {how} gives "
