@@ -12,7 +12,8 @@ import pytest
 from assocopt import AssignmentProblem, solve
 from assocopt.cli import main
 from assocopt.solvers import Option, OptionError, get_backend, registered
-from assocopt.solvers.options import COMMON_OPTIONS, options_page
+from assocopt.solvers.base import options_page
+from assocopt.solvers.options import COMMON_OPTIONS
 
 DOCS = Path(__file__).resolve().parents[1] / "docs"
 

@@ -251,7 +251,8 @@ def _option_rows(name: str) -> dict[str, Any]:
 def _cmd_options(args: argparse.Namespace, out: TextIO) -> int:
     """``assocopt solvers --options NAME``: the declared options, as a table."""
     from ..solvers import registered
-    from ..solvers.options import COMMON_NAMES, options_page, options_table
+    from ..solvers.base import options_page
+    from ..solvers.options import COMMON_NAMES, options_table
 
     if args.markdown:
         if args.options != "all":

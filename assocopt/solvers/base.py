@@ -24,11 +24,11 @@ from ..errors import (InvalidProblemError, SolverCapabilityError, SolverNotInsta
                       UnknownSolverError)
 from ..problem import AssignmentProblem
 from ..solution import Status
-from .options import Option, check_common, parse_options
+from .options import COMMON_OPTIONS, Option, check_common, options_table, parse_options
 
 __all__ = ["SolveOptions", "RawResult", "Backend", "register", "declare", "get_backend",
            "registered", "available", "names", "check_capabilities", "empty_answer",
-           "Option"]
+           "Option", "options_page"]
 
 
 @dataclass(frozen=True)
@@ -320,3 +320,34 @@ def get_backend(name: str) -> type[Backend]:
 def available() -> list[str]:
     """Names of the back ends whose packages are installed."""
     return sorted(n for n, cls in registered().items() if cls.is_available())
+
+
+def _md(text: str) -> str:
+    return text.replace("|", "\\|")
+
+
+def options_page() -> str:
+    """The Markdown page ``docs/solver-options.md``, generated from the declarations."""
+    lines = ["# Back-end options", "",
+             "Generated from the back ends' declared options by",
+             "`python -m assocopt solvers --options all --markdown > "
+             "docs/solver-options.md`;",
+             "`tests/test_options.py` checks that this page matches them.  Every back "
+             "end also takes the",
+             "common options below; an unknown option is an error that lists the "
+             "valid ones.", "",
+             "## Common options (every back end)", "",
+             "| option | accepts | default | description |", "|---|---|---|---|"]
+    lines += [f"| `{o.name}` | {_md(o.describe())} | `{o.default_text()}` | {_md(o.doc)} |"
+              for o in COMMON_OPTIONS]
+    for name, cls in sorted(registered().items()):
+        lines += ["", f"## `{name}`", ""]
+        if cls.options:
+            lines += ["| option | accepts | default | description |", "|---|---|---|---|"]
+            lines += [f"| `{n}` | {_md(a)} | `{_md(d)}` | {_md(doc)} |"
+                      for n, a, d, doc in options_table(cls)]
+        else:
+            lines.append("No options of its own.")
+        if cls.native_options:
+            lines += ["", f"Also accepts {cls.native_options}, passed through by name."]
+    return "\n".join(lines) + "\n"

@@ -13,7 +13,8 @@ checked by :func:`check_common`, the one place that does it.
 
 The same declarations feed ``assocopt solvers --options NAME``, the checks of model
 files (:mod:`assocopt.models`) and the page ``docs/solver-options.md``
-(:func:`options_page`).
+(:func:`assocopt.solvers.base.options_page`, which lists the registry).  This module
+reads a back end's declaration only, never the registry.
 
 Examples
 --------
@@ -30,17 +31,25 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
-from typing import TYPE_CHECKING, Any, Iterable, Mapping
+from typing import Any, Iterable, Mapping, Protocol
 
 import numpy as np
 
 from ..errors import InvalidProblemError
 
-if TYPE_CHECKING:   # pragma: no cover
-    from .base import Backend
-
 __all__ = ["Option", "OptionError", "COMMON_OPTIONS", "COMMON_NAMES", "parse_options",
-           "check_common", "options_table", "options_page"]
+           "check_common", "options_table"]
+
+class Declaring(Protocol):
+    """What the checks read of a back-end class (:class:`~assocopt.solvers.base.Backend`)."""
+
+    name: str
+    options: tuple["Option", ...]
+    native_options: str
+
+    def is_native_option(self, name: str) -> bool:
+        """Whether ``name`` is passed through to the back end's own solver."""
+
 
 #: Kinds of value an :class:`Option` takes.
 KINDS = ("int", "float", "bool", "choice", "str", "dict", "axes")
@@ -207,7 +216,7 @@ def check_common(time_limit: Any = None, mip_gap: Any = 0.0, threads: Any = None
     return out[0], out[1], out[2], out[3]
 
 
-def parse_options(backend: type["Backend"], given: Mapping[str, Any]) -> dict[str, Any]:
+def parse_options(backend: type[Declaring], given: Mapping[str, Any]) -> dict[str, Any]:
     """``given`` checked against ``backend.options``: every declared option with its
     value or default, plus any names the back end passes through to its solver.
 
@@ -236,7 +245,7 @@ def parse_options(backend: type["Backend"], given: Mapping[str, Any]) -> dict[st
 _DECLARED: dict[type, tuple[Any, ...]] = {}
 
 
-def _declared(backend: type["Backend"]
+def _declared(backend: type[Declaring]
               ) -> tuple[dict[str, Option], dict[str, Any], tuple[str, ...]]:
     """``backend``'s options by name, their defaults and the names of the mutable
     ones (cached per class while its declaration is the same object: options are
@@ -250,7 +259,7 @@ def _declared(backend: type["Backend"]
     return hit[1], hit[2], hit[3]
 
 
-def unknown_message(backend: type["Backend"], key: Any) -> str:
+def unknown_message(backend: type[Declaring], key: Any) -> str:
     """The one wording of an unknown option."""
     names = ", ".join(o.name for o in backend.options) or "none"
     more = f"; it also takes {backend.native_options}" if backend.native_options else ""
@@ -258,39 +267,6 @@ def unknown_message(backend: type["Backend"], key: Any) -> str:
 
 
 # ---------------------------------------------------------------- documentation
-def options_table(backend: type["Backend"]) -> list[tuple[str, str, str, str]]:
+def options_table(backend: type[Declaring]) -> list[tuple[str, str, str, str]]:
     """Rows ``(name, accepts, default, description)`` of ``backend``'s options."""
     return [(o.name, o.describe(), o.default_text(), o.doc) for o in backend.options]
-
-
-def _md(text: str) -> str:
-    return text.replace("|", "\\|")
-
-
-def options_page() -> str:
-    """The Markdown page ``docs/solver-options.md``, generated from the declarations."""
-    from . import registered
-
-    lines = ["# Back-end options", "",
-             "Generated from the back ends' declared options by",
-             "`python -m assocopt solvers --options all --markdown > "
-             "docs/solver-options.md`;",
-             "`tests/test_options.py` checks that this page matches them.  Every back "
-             "end also takes the",
-             "common options below; an unknown option is an error that lists the "
-             "valid ones.", "",
-             "## Common options (every back end)", "",
-             "| option | accepts | default | description |", "|---|---|---|---|"]
-    lines += [f"| `{o.name}` | {_md(o.describe())} | `{o.default_text()}` | {_md(o.doc)} |"
-              for o in COMMON_OPTIONS]
-    for name, cls in sorted(registered().items()):
-        lines += ["", f"## `{name}`", ""]
-        if cls.options:
-            lines += ["| option | accepts | default | description |", "|---|---|---|---|"]
-            lines += [f"| `{n}` | {_md(a)} | `{_md(d)}` | {_md(doc)} |"
-                      for n, a, d, doc in options_table(cls)]
-        else:
-            lines.append("No options of its own.")
-        if cls.native_options:
-            lines += ["", f"Also accepts {cls.native_options}, passed through by name."]
-    return "\n".join(lines) + "\n"
