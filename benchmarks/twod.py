@@ -40,8 +40,7 @@ sys.path.insert(0, str(ROOT))
 from assocopt import AssignmentProblem, kbest, marginals, solve  # noqa: E402
 from assocopt.generate import gated_2d  # noqa: E402
 from assocopt.solvers.bruteforce import enumerate_solutions  # noqa: E402
-from assocopt.solvers.lap import augmented_edges, lapx_available  # noqa: E402
-from assocopt.solvers.scipy_lsa import augmented_matrix  # noqa: E402
+from assocopt.solvers.lap import augmented_edges, augmented_matrix, lapx_available  # noqa: E402
 
 JSON = ROOT / "docs" / "benchmarks-2d.json"
 PAGE = ROOT / "docs" / "benchmarks-2d.md"

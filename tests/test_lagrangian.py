@@ -341,7 +341,7 @@ def test_lap_option_lapx_without_the_package_names_it():
 
 
 def test_lapjv_backend_names_the_missing_package(monkeypatch):
-    from assocopt.solvers.lap import LapjvBackend
+    from assocopt.solvers.lapjv import LapjvBackend
     monkeypatch.setattr(LapjvBackend, "module", "lap_not_installed_here")
     with pytest.raises(SolverNotInstalledError, match="lapx"):
         solve(AssignmentProblem.dense(np.ones((2, 2))), "lapjv")

@@ -20,7 +20,7 @@ from .options import Option, OptionError
 #: name -> module, in the order of the listing (the registry's order).
 BACKEND_MODULES: dict[str, str] = {
     "highs": "highs", "scipy": "scipy_milp", "scipy-lsa": "scipy_lsa",
-    "bruteforce": "bruteforce", "greedy": "greedy", "lapjv": "lap",
+    "bruteforce": "bruteforce", "greedy": "greedy", "lapjv": "lapjv",
     "lagrangian": "lagrangian", "lagrangian-exact": "lagrangian", "bnb": "bnb",
     "ortools-cpsat": "ortools_cpsat", "ortools-mip": "ortools_mip",
     "cvxpy": "cvxpy_backend",

@@ -41,7 +41,7 @@ from scipy.optimize import linear_sum_assignment as _scipy_lsa
 
 from ..solution import Status
 from .base import RawResult, empty_answer
-from .lap import LapInfeasibleError, linear_assignment
+from .lap import LapInfeasibleError, augmented_matrix, linear_assignment
 from .sparse2d import (assign_sparse_edges, prefer_sparse, selected_from_edges,
                        split_candidates)
 
@@ -86,11 +86,6 @@ def _lap(C: np.ndarray, method: str) -> tuple[np.ndarray, np.ndarray]:
         raise
 
 
-def _augmented(C: np.ndarray, rm: np.ndarray, cm: np.ndarray) -> np.ndarray:
-    from .scipy_lsa import augmented_matrix
-    return augmented_matrix(C, rm, cm)
-
-
 def assign_dense(C: np.ndarray, rm: np.ndarray, cm: np.ndarray, slack: bool = False,
                  method: str = "scipy", flags: tuple[bool, bool] | None = None
                  ) -> tuple[np.ndarray, str]:
@@ -127,7 +122,7 @@ def assign_dense(C: np.ndarray, rm: np.ndarray, cm: np.ndarray, slack: bool = Fa
         r, c = linear_assignment(C, method)
         cor[r] = c
         return cor, "plain"
-    r, c = linear_assignment(_augmented(C, rm, cm), method)
+    r, c = linear_assignment(augmented_matrix(C, rm, cm), method)
     real = (r < n1) & (c < n2)
     cor[r[real]] = c[real]
     return cor, "augmented"
@@ -203,8 +198,6 @@ def solve_2d(problem, options, engine: str, label: str, mode: str = "auto"):
 
 def _answer_positions(problem, cor: np.ndarray) -> np.ndarray:
     """Candidate positions of a ``col_of_row`` answer in the problem's tuple list."""
-    from .scipy_lsa import _positions
-
     n1, n2 = problem.sizes
     assigned = cor >= 0
     rows = np.flatnonzero(assigned)
@@ -216,3 +209,18 @@ def _answer_positions(problem, cor: np.ndarray) -> np.ndarray:
                             np.stack([miss_r + 1, 0 * miss_r], axis=1),
                             np.stack([0 * miss_c, miss_c + 1], axis=1)]).astype(np.int64)
     return _positions(problem, pairs)
+
+
+def _positions(problem: AssignmentProblem, pairs: np.ndarray) -> np.ndarray:
+    """Candidate positions of the 2-D tuples ``pairs`` (bulk search on packed keys)."""
+    n2 = problem.sizes[1] + 1
+    keys = problem.tuples[:, 0] * n2 + problem.tuples[:, 1]
+    order = np.argsort(keys, kind="stable")
+    want = pairs[:, 0] * n2 + pairs[:, 1]
+    pos = np.searchsorted(keys[order], want)
+    pos = np.minimum(pos, len(keys) - 1)
+    found = keys[order][pos] == want
+    if not found.all():
+        missing = pairs[~found][0].tolist()
+        raise RuntimeError(f"the 2-D LAP chose {missing}, which is not a candidate")
+    return order[pos]

@@ -1,7 +1,9 @@
 """2-D linear assignment engines: dense (scipy or lapx), sparse, with miss costs, duals.
 
-These helpers are the work-horse of the Lagrangian S-D solver
-(:mod:`assocopt.solvers.lagrangian`) and back the optional ``lapjv`` 2-D back end.
+This module owns the 2-D LAP: the engines and the augmentations that turn miss costs
+into a plain LAP; everything else on the 2-D path (:mod:`.sparse2d`, :mod:`.dense2d`,
+the ``scipy-lsa`` and ``lapjv`` back ends, the Lagrangian S-D solver
+:mod:`assocopt.solvers.lagrangian`) builds on it and it imports none of them.
 
 * :func:`linear_assignment` -- a dense (possibly rectangular) LAP, ``inf`` = forbidden,
   scipy's semantics (the smaller side fully assigned).  It runs lapx's Jonker-Volgenant
@@ -13,6 +15,8 @@ These helpers are the work-horse of the Lagrangian S-D solver
   (:func:`scipy.sparse.csgraph.min_weight_full_bipartite_matching`) on the standard
   augmentation whose dummy-dummy block is the transpose of the edge pattern, so memory
   grows with the number of edges, not with ``n1 * n2``.
+* :func:`augmented_matrix` / :func:`augmented_edges` -- the ``(n1+n2)``-square
+  augmentation of 2-D assignment with miss costs, dense or as an edge list.
 * :func:`assignment_duals` -- dual-feasible potentials of an optimal assignment
   (shortest paths in the residual graph, vectorised Bellman-Ford), used for
   reduced-cost fixing.  Feasibility is enforced by construction, so the bounds derived
@@ -27,13 +31,9 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..problem import AssignmentProblem
-from ..solution import Status
-from .base import Backend, Option, RawResult, SolveOptions, register
-
 __all__ = ["LapInfeasibleError", "lapx_available", "linear_assignment",
-           "assign_with_misses", "Assignment2D", "assignment_duals", "LapjvBackend",
-           "LAP_METHODS"]
+           "assign_with_misses", "Assignment2D", "assignment_duals", "augmented_matrix",
+           "augmented_edges", "LAP_METHODS"]
 
 #: Accepted ``method`` values of :func:`linear_assignment` / :func:`assign_with_misses`.
 LAP_METHODS = ("auto", "scipy", "lapx", "sparse")
@@ -198,6 +198,22 @@ def _dense(n1: int, n2: int, rows, cols, weights) -> np.ndarray:
     return M
 
 
+def augmented_matrix(C: np.ndarray, row_miss: np.ndarray, col_miss: np.ndarray) -> np.ndarray:
+    """The ``(n1+n2) x (n2+n1)`` LAP equivalent to 2-D assignment with miss costs.
+
+    Row ``n1 + j`` paired with column ``j`` means column j unassigned; column
+    ``n2 + i`` paired with row ``i`` means row i unassigned; dummy rows and dummy
+    columns pair with each other at cost 0.
+    """
+    n1, n2 = C.shape
+    big = np.full((n1 + n2, n2 + n1), np.inf)
+    big[:n1, :n2] = C
+    big[np.arange(n1), n2 + np.arange(n1)] = row_miss
+    big[n1 + np.arange(n2), np.arange(n2)] = col_miss
+    big[n1:, n2:] = 0.0
+    return big
+
+
 def augmented_edges(n1: int, n2: int, rows: np.ndarray, cols: np.ndarray,
                     weights: np.ndarray, row_miss: np.ndarray, col_miss: np.ndarray
                     ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
@@ -280,34 +296,3 @@ def assignment_duals(size: int, rows: np.ndarray, cols: np.ndarray, weights: np.
     np.minimum.at(alpha, rows, w - beta[cols])
     alpha[~np.isfinite(alpha)] = 0.0   # rows without edges cannot occur in a matching
     return alpha, beta
-
-
-# --------------------------------------------------------------------------- back end
-@register
-class LapjvBackend(Backend):
-    """Exact 2-D assignment with lapx's Jonker-Volgenant code (optional package).
-
-    Same cases as ``scipy-lsa`` (:mod:`assocopt.solvers.dense2d`); large gated
-    candidate lists use the sparse engine (:mod:`assocopt.solvers.sparse2d`).  Extra
-    option ``method``: ``"auto"`` (default), ``"lapx"`` or ``"sparse"``.
-    """
-
-    name = "lapjv"
-    module = "lap"
-    distribution = "lapx"
-    description = ("lapx Jonker-Volgenant LAP (dense) / compiled sparse LAP (gated lists), "
-                   "2-D only")
-    max_ndim = 2
-    options = (Option("method", "choice", "auto", "LAP engine: lapx (dense; 'auto' "
-                      "means lapx) or the sparse engine of gated lists",
-                      choices=("auto", "lapx", "sparse")),)
-
-    def solve(self, problem: AssignmentProblem, options: SolveOptions) -> RawResult:
-        from .dense2d import solve_2d
-
-        method = self.settings(problem, options)["method"]
-        mode = {"auto": "auto", "lapx": "dense", "sparse": "sparse"}[method]
-        raw = solve_2d(problem, options, "lapx", self.name, mode)
-        raw.info["lap_method"] = raw.info.pop("lsa_mode", None)
-        raw.info["lapx_version"] = self.version()
-        return raw
