@@ -6,6 +6,7 @@
 3.0
 """
 
+from ._version import __version__
 from .errors import (AssocoptError, InstanceFormatError, InvalidProblemError,
                      ProblemTooLargeError, SolverCapabilityError,
                      SolverNotInstalledError, UnknownSolverError)
@@ -15,8 +16,6 @@ from . import solvers
 from .api import choose_solver, solve
 from .kbest import Ranked, kbest
 from .marginals import Marginals, marginals
-
-__version__ = "0.1.0"
 
 __all__ = ["AssignmentProblem", "Solution", "Status", "solve", "choose_solver", "solvers",
            "kbest", "Ranked", "marginals", "Marginals",

@@ -211,7 +211,7 @@ def _solutions_list(problem: AssignmentProblem, cor: np.ndarray) -> list[Solutio
 def _ranked(problem: AssignmentProblem, out: list) -> list[Solution]:
     """Solutions from ``(objective, selected, tuples)``, sorted by objective, then
     ``selected`` (minimisation sense; flipped for a maximisation problem)."""
-    from . import __version__
+    from ._version import __version__
 
     objs = [e[0] for e in out]
     if any(a >= b for a, b in zip(objs, objs[1:])):   # ties (or rounding): reorder

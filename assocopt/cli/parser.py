@@ -26,7 +26,7 @@ def _build_parser() -> argparse.ArgumentParser:
         description="Data association / assignment problems as optimisation models.",
         epilog="exit codes: 0 solved, 1 infeasible, 2 bad input, 3 limit reached without "
                "a solution, 4 solver or internal error, 130 interrupted")
-    from .. import __version__
+    from .._version import __version__
     parser.add_argument("--version", action="version", version=f"assocopt {__version__}")
     parser.add_argument("--max-bytes", type=_max_bytes, metavar="N", default=None,
                         help="largest instance file read, in bytes (default 1 GiB; also "

@@ -213,7 +213,7 @@ class Backend:
         ``__version__`` when the module is the distribution (no metadata scan: the
         first costs 10-15 ms), else the installed metadata."""
         if cls.own_method or cls.distribution is None:
-            from .. import __version__
+            from .._version import __version__
             return __version__
         dist = cls.distribution
         mod = sys.modules.get(dist) if (cls.module or dist) == dist else None
