@@ -1,25 +1,44 @@
 """The data term of every named S-D cost (paper 002): per tuple, the sum over its real
 measurements of 1/2 (statistical distance or divergence) between the measurement and
-the pseudo-measurement of the tuple's estimated position.  Used by
-:mod:`assocopt.tracking.costs.sd_builder`, which adds the constant terms.
+the pseudo-measurement of the tuple's estimated position, read from a
+:class:`TupleGeometry`.  :mod:`assocopt.tracking.costs.sd_builder` builds the geometry
+and adds the constant terms.
 """
 
 from __future__ import annotations
 
-from typing import TYPE_CHECKING
+from dataclasses import dataclass, field
 
 import numpy as np
 
 from ..localisation import wrap_angle
 from . import kld as dv
 
-if TYPE_CHECKING:                                    # pragma: no cover
-    from .sd_builder import TupleGeometry
-
-__all__ = ["data_term"]
+__all__ = ["TupleGeometry", "data_term"]
 
 
-def _components(g: "TupleGeometry") -> dict[str, np.ndarray]:
+@dataclass(frozen=True)
+class TupleGeometry:
+    """Per-tuple measurements, localisation and pseudo-measurements (shared by all costs)."""
+
+    tuples: np.ndarray            # (K, N)
+    mask: np.ndarray              # (K, N) real measurements
+    meas: np.ndarray              # (K, N, 2)
+    R: np.ndarray                 # (K, N, 2, 2)
+    x: np.ndarray                 # (K, 3)
+    P: np.ndarray                 # (K, 3, 3)
+    valid: np.ndarray             # (K,) localised
+    pm_mean: np.ndarray           # (K, N, 2)
+    pm_cov: np.ndarray            # (K, N, 2, 2)
+    options: dict = field(default_factory=dict)
+    cache: dict = field(default_factory=dict, repr=False, compare=False)
+
+    @property
+    def n_real(self) -> np.ndarray:
+        return self.mask.sum(axis=1)
+
+
+def _components(g: TupleGeometry) -> dict[str, np.ndarray]:
     """(K, N) component arrays shared by every data term (computed once per geometry)."""
     cached = g.cache.get("components")
     if cached is not None:
@@ -41,7 +60,7 @@ def _components(g: "TupleGeometry") -> dict[str, np.ndarray]:
     return comp
 
 
-def data_term(g: "TupleGeometry", method: str) -> np.ndarray:
+def data_term(g: TupleGeometry, method: str) -> np.ndarray:
     """Per tuple: sum over real sensors of 1/2 (statistical distance or divergence)."""
     c = _components(g)
     da, db, ra, rb, rab = c["da"], c["db"], c["ra"], c["rb"], c["rab"]

@@ -30,7 +30,7 @@ from numpy.typing import ArrayLike
 from ...errors import InvalidProblemError
 from ..localisation import localise_indexed, pseudo_measurements
 from ...problem import AssignmentProblem
-from .data_terms import data_term
+from .data_terms import TupleGeometry, data_term
 from .pattipati import NORMALISATIONS, constant_terms
 
 __all__ = ["Scan", "COSTS", "PRINTED_COSTS", "candidate_tuples", "TupleGeometry",
@@ -199,27 +199,6 @@ def candidate_tuples(sizes: Sequence[int], pd: ArrayLike,
         others_miss = ((~real) & ~can_miss[None, :]).sum(axis=1) == 0
         ok |= single & (fa_ok | others_miss)
     return T[ok]
-
-
-@dataclass(frozen=True)
-class TupleGeometry:
-    """Per-tuple measurements, localisation and pseudo-measurements (shared by all costs)."""
-
-    tuples: np.ndarray            # (K, N)
-    mask: np.ndarray              # (K, N) real measurements
-    meas: np.ndarray              # (K, N, 2)
-    R: np.ndarray                 # (K, N, 2, 2)
-    x: np.ndarray                 # (K, 3)
-    P: np.ndarray                 # (K, 3, 3)
-    valid: np.ndarray             # (K,) localised
-    pm_mean: np.ndarray           # (K, N, 2)
-    pm_cov: np.ndarray            # (K, N, 2, 2)
-    options: dict = field(default_factory=dict)
-    cache: dict = field(default_factory=dict, repr=False, compare=False)
-
-    @property
-    def n_real(self) -> np.ndarray:
-        return self.mask.sum(axis=1)
 
 
 def tuple_geometry(scan: Scan, tuples: np.ndarray | None = None, *, localiser: str = "ls",
