@@ -10,9 +10,10 @@ from typing import Any, Mapping, Sequence
 import numpy as np
 
 from ...experiments import Experiment
-from ...tracking.costs.association_degree import DegreeParams, statistical_distance, tolerance
+from ...tracking.costs.association_degree import statistical_distance
 from ...tracking.decide.max_degree import DecisionOptions, TrackAssociator, shared_columns
-from ...tracking.scenarios.yan2010 import OURS, PAPER, Yan2010
+from ...tracking.scenarios.yan2010 import OURS, PAPER
+from .setting import SCENARIO_KEYS, degree_params, scenario_of
 from .three_node import three_node_metrics
 
 __all__ = ["PAPER_TABLE1", "TABLE1_N", "DEFAULTS", "METHODS", "LABELS", "PAPER_METHODS",
@@ -94,24 +95,7 @@ DEFAULTS: dict[str, Any] = {
     "three_node_n": (10, 30, 60),
     "three_node_times": (5.0, 20.0, 80.0),
 }
-_SCENARIO_KEYS = ("tracker", "init", "q_true", "q_filter", "period", "duration", "freq_range",
-                  "pw_range", "pri_range", "emitter_types", "region_scale")
 _RUN_KEYS = ("weights", "eps", "k_tol", "fix_at", "cost", "gate_alpha", "solver")
-
-
-def scenario_of(setting: Mapping[str, Any], nodes: int = 2) -> Yan2010:
-    """The scenario of a setting."""
-    kw = {k: (tuple(setting[k]) if isinstance(setting[k], list) else setting[k])
-          for k in _SCENARIO_KEYS if k in setting}
-    return Yan2010(n_targets=int(setting["n"]), nodes=nodes, **kw)
-
-
-def degree_params(setting: Mapping[str, Any], sc: Yan2010, fusion: str = "candidate",
-                  a: int = 0, b: int = 1) -> DegreeParams:
-    """Weights and tolerances of the degrees between nodes ``a`` and ``b``."""
-    sig = sc.feature_sigmas()
-    tols = tuple(tolerance(sig[a, k], sig[b, k], float(setting["k_tol"])) for k in range(3))
-    return DegreeParams(weights=tuple(setting["weights"]), tolerances=tols, fusion=fusion)
 
 
 def decision_options(setting: Mapping[str, Any], method: str) -> DecisionOptions:
@@ -176,7 +160,7 @@ def _options(options: Mapping[str, Any] | None) -> dict[str, Any]:
 
 def _common(o: Mapping[str, Any]) -> dict[str, Any]:
     return {k: (list(o[k]) if isinstance(o[k], tuple) else o[k])
-            for k in _SCENARIO_KEYS + _RUN_KEYS}
+            for k in SCENARIO_KEYS + _RUN_KEYS}
 
 
 def experiments(runs: int, seed: int, options: Mapping[str, Any] | None = None,

@@ -17,6 +17,7 @@ import numpy as np
 from ...tracking.costs.association_degree import feature_degrees, fused_degree, statistical_distance
 from ...tracking.decide.max_degree import assignment_rule
 from ...tracking.decide.multi_node import three_node_decision
+from .setting import degree_params, scenario_of
 
 __all__ = ["three_node_metrics"]
 
@@ -30,7 +31,6 @@ def _degrees(run, k: int, a: int, b: int, params) -> np.ndarray:
 def three_node_metrics(setting: Mapping[str, Any], methods: Sequence[str],
                        seed: np.random.SeedSequence) -> dict[str, dict[str, float]]:
     """One three-node run decided by ``"sd-3"`` and ``"pairwise-2d"``."""
-    from .experiment import degree_params, scenario_of      # no import cycle at load time
     rng = np.random.default_rng(seed)
     sc = scenario_of(setting, nodes=3)
     run = sc.simulate(rng)
