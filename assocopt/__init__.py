@@ -7,15 +7,15 @@
 """
 
 from ._version import __version__
-from .errors import (AssocoptError, InstanceFormatError, InvalidProblemError,
-                     ProblemTooLargeError, SolverCapabilityError,
-                     SolverNotInstalledError, UnknownSolverError)
-from .problem import AssignmentProblem
-from .solution import Solution, Status
+from .runtime.errors import (AssocoptError, InstanceFormatError, InvalidProblemError,
+                             ProblemTooLargeError, SolverCapabilityError,
+                             SolverNotInstalledError, UnknownSolverError)
+from .problems.problem import AssignmentProblem
+from .model.solution import Solution, Status
 from . import solvers
-from .api import choose_solver, solve
-from .kbest import Ranked, kbest
-from .marginals import Marginals, marginals
+from .solving.api import choose_solver, solve
+from .ranking.kbest import Ranked, kbest
+from .ranking.marginals import Marginals, marginals
 
 __all__ = ["AssignmentProblem", "Solution", "Status", "solve", "choose_solver", "solvers",
            "kbest", "Ranked", "marginals", "Marginals",

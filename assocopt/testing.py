@@ -28,8 +28,8 @@ from typing import Any, Sequence
 
 import numpy as np
 
-from .problem import AssignmentProblem
-from .solution import Solution, Status
+from .problems.problem import AssignmentProblem
+from .model.solution import Solution, Status
 
 __all__ = ["KINDS", "random_problem", "random_scans", "problems", "generated_problems", "assert_optimal",
            "assert_feasible", "assert_valid_bound", "reference_optimum", "stored_instances",
@@ -122,7 +122,7 @@ def _hypothesis(helper: str = "draw_costs") -> Any:
     except ModuleNotFoundError as exc:
         if exc.name is None or exc.name.split(".")[0] != "hypothesis":
             raise
-        from .errors import MissingDependencyError
+        from .runtime.errors import MissingDependencyError
         raise MissingDependencyError(
             f"assocopt.testing.{helper}() is a hypothesis strategy and needs the "
             "hypothesis package: pip install hypothesis (or pip install "
@@ -230,7 +230,7 @@ def reference_optimum(problem: AssignmentProblem) -> tuple[float, str]:
 
 
 def _reference_optimum(problem: AssignmentProblem) -> tuple[float, str]:
-    from .api import solve
+    from .solving.api import solve
     if problem.optimum is not None:
         return float(problem.optimum), "recorded optimum"
     if problem.n_candidates <= BRUTE_FORCE_MAX_CANDIDATES:
@@ -290,7 +290,7 @@ def stored_instances(directory: str | os.PathLike[str] | None = None) -> list[Pa
     Default: ``./instances`` when it exists, else the ``instances/`` folder of the
     assocopt source checkout, else the copies installed with the package.
     """
-    from .generate import default_instances_dir
+    from .workflow.generate import default_instances_dir
 
     folder = Path(directory) if directory is not None else default_instances_dir()
     if not folder.is_dir():
@@ -300,7 +300,7 @@ def stored_instances(directory: str | os.PathLike[str] | None = None) -> list[Pa
 
 def generated_problems(kinds: Sequence[str] = ("dense", "sparse", "planted"), *,
                        max_axes: int = 4, max_size: int = 4) -> Any:
-    """Hypothesis strategy of instances from :func:`assocopt.generate.generate`.
+    """Hypothesis strategy of instances from :func:`assocopt.workflow.generate.generate`.
 
     Draws a generator, 2..``max_axes`` axes of size 1..``max_size`` and a seed.
     ``"planted"`` problems carry their optimum (known by construction), so
@@ -308,7 +308,7 @@ def generated_problems(kinds: Sequence[str] = ("dense", "sparse", "planted"), *,
     """
     st = _hypothesis("generated_problems")
 
-    from .generate import GENERATORS, generate
+    from .workflow.generate import GENERATORS, generate
 
     bad = [k for k in kinds if k not in GENERATORS]
     if bad or not kinds:

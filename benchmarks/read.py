@@ -40,7 +40,7 @@ SHARED = ROOT.parent / "shared" / "ap_instances"
 # ------------------------------------------------------------------ the files
 def _dense(sizes: tuple[int, ...], seed: int, kind: str) -> Any:
     from assocopt import AssignmentProblem
-    from assocopt.generate import generate_dense
+    from assocopt.workflow.generate import generate_dense
     rng = np.random.default_rng(seed)
     if kind == "int":
         return generate_dense(rng, sizes, low=1000, high=2000)

@@ -38,7 +38,7 @@ ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))
 
 from assocopt import AssignmentProblem, kbest, marginals, solve  # noqa: E402
-from assocopt.generate import gated_2d  # noqa: E402
+from assocopt.workflow.generate import gated_2d  # noqa: E402
 from assocopt.solvers.bruteforce import enumerate_solutions  # noqa: E402
 from assocopt.solvers.lap import augmented_edges, augmented_matrix, lapx_available  # noqa: E402
 

@@ -146,7 +146,7 @@ def test_auto_picks_bnb_for_small_sd():
 
 
 def test_auto_without_numba_uses_lagrangian_exact(monkeypatch):
-    import assocopt.api as api
+    import assocopt.solving.api as api
     monkeypatch.setattr(api, "_numba_installed", lambda: False)
     assert choose_solver(AssignmentProblem.dense(np.ones((3, 3, 3)))) == "lagrangian-exact"
 
@@ -226,16 +226,16 @@ def test_cli_prints_how_long_compilation_took(monkeypatch, capsys):
     giving the time, whether or not the cache check announced it beforehand."""
     from pathlib import Path
 
-    import assocopt.api
+    import assocopt.solving.api
     from assocopt.cli import main
     example = Path(__file__).resolve().parents[1] / "instances" / "sd-bearing-3s.json"
-    real = assocopt.api.solve
+    real = assocopt.solving.api.solve
 
     def compiled(*args, **kwargs):
         sol = real(*args, **kwargs)
         sol.times["compile"] = 12.34
         return sol
-    monkeypatch.setattr(assocopt.api, "solve", compiled)
+    monkeypatch.setattr(assocopt.solving.api, "solve", compiled)
     monkeypatch.setattr(kern, "cached", lambda: True)
     assert main(["solve", str(example)]) == 0
     assert capsys.readouterr().err == ("assocopt: compiled the numba kernels in 12.3 s "

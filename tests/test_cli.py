@@ -214,7 +214,7 @@ def _fake_solve(result):
 
 
 def test_limit_without_solution_exit_3(monkeypatch, capsys):
-    monkeypatch.setattr("assocopt.api.solve",
+    monkeypatch.setattr("assocopt.solving.api.solve",
                         _fake_solve(Solution(Status.TIME_LIMIT, solver="highs",
                                              message="HiGHS: Time limit reached")))
     assert main(["solve", str(EXAMPLES / "example-3d.json")]) == EXIT_LIMIT
@@ -224,7 +224,7 @@ def test_limit_without_solution_exit_3(monkeypatch, capsys):
 
 
 def test_solver_error_status_exit_4(monkeypatch, capsys):
-    monkeypatch.setattr("assocopt.api.solve",
+    monkeypatch.setattr("assocopt.solving.api.solve",
                         _fake_solve(Solution(Status.ERROR, solver="highs",
                                              message="back end returned\nan infeasible assignment")))
     assert main(["solve", str(EXAMPLES / "example-3d.json"), "--json"]) == EXIT_INTERNAL
@@ -235,14 +235,14 @@ def test_solver_error_status_exit_4(monkeypatch, capsys):
 
 
 def test_unexpected_exception_exit_4(monkeypatch, capsys):
-    monkeypatch.setattr("assocopt.api.solve", _fake_solve(RuntimeError("kaboom\nsecond line")))
+    monkeypatch.setattr("assocopt.solving.api.solve", _fake_solve(RuntimeError("kaboom\nsecond line")))
     assert main(["solve", str(EXAMPLES / "example-3d.json")]) == EXIT_INTERNAL
     line = one_error_line(capsys.readouterr().err)
     assert "internal error" in line and "RuntimeError" in line and "kaboom" in line
 
 
 def test_keyboard_interrupt_exit_130(monkeypatch, capsys):
-    monkeypatch.setattr("assocopt.api.solve", _fake_solve(KeyboardInterrupt()))
+    monkeypatch.setattr("assocopt.solving.api.solve", _fake_solve(KeyboardInterrupt()))
     assert main(["solve", str(EXAMPLES / "example-3d.json")]) == EXIT_INTERRUPTED
     assert "Traceback" not in capsys.readouterr().err
 

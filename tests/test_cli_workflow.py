@@ -17,7 +17,7 @@ import pytest
 from assocopt import AssignmentProblem, solve
 from assocopt.cli import (EXIT_BAD_INPUT, EXIT_INFEASIBLE, EXIT_INTERNAL, EXIT_OK, main)
 from assocopt.io import export_model, solve_model_file, write_public
-from assocopt.generate import catalogue, generate, write_index
+from assocopt.workflow.generate import catalogue, generate, write_index
 from assocopt.io import read_instance, write_instance
 from assocopt.solvers import registered
 
@@ -218,7 +218,7 @@ def test_compare_keeps_going_when_a_back_end_raises(monkeypatch, capsys):
 
 
 def test_compare_progress_counter_without_tqdm(monkeypatch):
-    from assocopt.progress import Progress
+    from assocopt.runtime.progress import Progress
 
     monkeypatch.setitem(sys.modules, "tqdm", None)           # as if tqdm were missing
     stream = io.StringIO()
@@ -236,8 +236,8 @@ def test_compare_progress_counter_without_tqdm(monkeypatch):
 
 
 def test_compare_uses_the_shared_progress_helper(monkeypatch):
-    """compare() reports through assocopt.progress.Progress, one step per run."""
-    from assocopt import compare as cmp
+    """compare() reports through assocopt.runtime.progress.Progress, one step per run."""
+    from assocopt.workflow import compare as cmp
 
     seen = []
 
@@ -253,7 +253,7 @@ def test_compare_uses_the_shared_progress_helper(monkeypatch):
 
 
 def test_compare_repeat_keeps_the_fastest_and_python_api():
-    from assocopt.compare import compare
+    from assocopt.workflow.compare import compare
 
     p = read_instance(INSTANCES / "example-sd.json")
     res = compare([p], solvers=["highs"], repeat=3, progress=False)
@@ -330,7 +330,7 @@ def test_export_names_columns_after_tuples(tmp_path):
 
 
 def test_export_refuses_an_empty_problem(tmp_path):
-    from assocopt.errors import InvalidProblemError
+    from assocopt.runtime.errors import InvalidProblemError
 
     empty = AssignmentProblem.sparse([0, 0], np.zeros((0, 2), int), [])
     with pytest.raises(InvalidProblemError, match="nothing to export"):

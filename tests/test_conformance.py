@@ -329,7 +329,7 @@ def test_stopped_run_is_never_optimal(name):
 
 
 def _finalised(p, name, raw):
-    from assocopt.api import _finalise
+    from assocopt.solving.api import _finalise
     return _finalise(p, registered()[name], raw, None)
 
 

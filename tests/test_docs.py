@@ -109,7 +109,7 @@ def test_guide_runs_in_order(workspace, capsys):
 
 
 def test_guide_toml_models_are_valid(tmp_path):
-    from assocopt.models import load_model
+    from assocopt.workflow.models import load_model
 
     written = [(t, body) for lang, body, t, _ in blocks() if lang == "toml" and t]
     assert written, "the guide shows how to write a model"

@@ -41,7 +41,7 @@ MODULES = _with_examples()
 def test_examples_are_found():
     # the package documents its main entry points by example: if the walk above
     # stopped finding them, the parametrised test below would silently shrink
-    assert {"assocopt.api", "assocopt.problem", "assocopt.testing",
+    assert {"assocopt.solving.api", "assocopt.problems.problem", "assocopt.testing",
             "assocopt.solvers.options"} <= set(MODULES)
     assert sum(len(t.examples) for m in MODULES
                for t in doctest.DocTestFinder().find(importlib.import_module(m), m)) >= 48

@@ -14,7 +14,7 @@ import time
 import numpy as np
 import pytest
 
-from assocopt.errors import AssocoptError
+from assocopt.runtime.errors import AssocoptError
 from assocopt.experiments import (Experiment, PerMethod, ResultStore, StoreMismatchError,
                                   TrialError, _demo_trial, association_metrics,
                                   run_experiment, setting_key, summarise, trial_seed)

@@ -22,10 +22,10 @@ import pytest
 
 from assocopt import AssignmentProblem, solve
 from assocopt.cli import main
-from assocopt.errors import InvalidProblemError, ProblemTooLargeError
-from assocopt.generate import generate_dense
+from assocopt.runtime.errors import InvalidProblemError, ProblemTooLargeError
+from assocopt.workflow.generate import generate_dense
 from assocopt.io import read_instance, write_instance
-from assocopt.solution import Status
+from assocopt.model.solution import Status
 from assocopt.solvers import registered
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -705,7 +705,7 @@ class TestRankingEdgeInputs:
 
     def test_kbest_takes_the_name_it_reports(self, capsys):
         from assocopt import kbest
-        from assocopt.errors import SolverCapabilityError
+        from assocopt.runtime.errors import SolverCapabilityError
 
         p = AssignmentProblem.two_d([[1.0, 2.0], [3.0, 1.0]], 2.0, 2.0)
         r = kbest(p, 4)

@@ -49,7 +49,7 @@ def test_package_data_globs_cover_the_shipped_files():
 def test_installed_copies_are_found_without_a_checkout(monkeypatch, tmp_path):
     """Outside the checkout (no ./instances, no project folder) the default instance
     folder is the packaged one."""
-    import assocopt.generate as gen
+    import assocopt.workflow.generate as gen
     from assocopt.testing import stored_instances
 
     monkeypatch.chdir(tmp_path)
@@ -68,7 +68,7 @@ def test_problems_without_hypothesis_names_the_install():
     (simulated in a fresh interpreter by blocking the import)."""
     code = ("import sys\nsys.modules['hypothesis'] = None\n"
             "import assocopt.testing as t\n"
-            "from assocopt.errors import MissingDependencyError\n"
+            "from assocopt.runtime.errors import MissingDependencyError\n"
             "for f in (t.problems, t.generated_problems):\n"
             "    try:\n        f()\n"
             "    except MissingDependencyError as exc:\n        print(exc)\n"
@@ -84,7 +84,7 @@ def test_problems_without_hypothesis_names_the_install():
 
 
 def test_missing_dependency_error_is_an_import_error():
-    from assocopt.errors import AssocoptError, MissingDependencyError
+    from assocopt.runtime.errors import AssocoptError, MissingDependencyError
     assert issubclass(MissingDependencyError, ImportError)
     assert issubclass(MissingDependencyError, AssocoptError)
 
@@ -148,7 +148,7 @@ def _run(installed: dict, *argv: str) -> subprocess.CompletedProcess:
 def test_installed_package_is_the_one_imported(installed):
     """The venv's assocopt is the installed copy, not the editable checkout."""
     done = _run(installed, installed["python"], "-c",
-                "import assocopt, assocopt.generate as g; print(assocopt.__file__); "
+                "import assocopt, assocopt.workflow.generate as g; print(assocopt.__file__); "
                 "print(g.default_instances_dir())")
     assert done.returncode == 0, done.stderr
     where, folder = done.stdout.splitlines()

@@ -21,7 +21,7 @@ import pytest
 from hypothesis import given, strategies as st
 
 from assocopt import AssignmentProblem
-from assocopt.errors import InstanceFormatError
+from assocopt.runtime.errors import InstanceFormatError
 from assocopt.io import json_format, json_scan, read_instance, write_instance
 from assocopt.io.common import TextFile, _floats, _lines
 from assocopt.io.json_scan import scan_json
@@ -163,7 +163,7 @@ def test_dense_round_trip(tmp_path_factory, sizes, seed, ints, forbid):
 
 @given(st.integers(0, 2 ** 32))
 def test_sparse_round_trip(tmp_path_factory, seed):
-    from assocopt.generate import generate_sparse
+    from assocopt.workflow.generate import generate_sparse
     p = generate_sparse(np.random.default_rng(seed), (3, 2, 3), decimals=None)
     path = tmp_path_factory.mktemp("rt") / "s.json"
     write_instance(p, path)

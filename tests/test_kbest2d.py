@@ -1,4 +1,4 @@
-"""The compiled 2-D ranking (assocopt.kbest2d, kernels sap / murty2d) against brute force
+"""The compiled 2-D ranking (assocopt.ranking.kbest2d, kernels sap / murty2d) against brute force
 and scipy: the k best objectives are the k smallest of the full enumeration, every
 solution once, in a fixed order; the warm-started LAP kernel agrees with scipy."""
 
@@ -10,7 +10,7 @@ from hypothesis import given, settings, strategies as st
 from scipy.optimize import linear_sum_assignment
 
 from assocopt import AssignmentProblem, kbest
-from assocopt import kbest2d
+from assocopt.ranking import kbest2d
 from assocopt.solvers.bruteforce import enumerate_solutions
 from assocopt.solvers.kernels.sap import augment, lap, lap_warm
 

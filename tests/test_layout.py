@@ -28,8 +28,8 @@ FORBIDDEN = {
     "assocopt.experiments": ("assocopt.tracking", "assocopt.reproduce"),
 }
 #: The one place the core names the tracking layer: the cost builders of scenario
-#: models, looked up by name like a plug-in (assocopt/models.py, COST_LAYER).
-PLUGIN_POINTS = {"assocopt.models": {"assocopt.tracking.costs"},
+#: models, looked up by name like a plug-in (assocopt/workflow/models.py, COST_LAYER).
+PLUGIN_POINTS = {"assocopt.workflow.models": {"assocopt.tracking.costs"},
                  "assocopt.cli.workflow_cmds": {"assocopt.reproduce"}}   # `assocopt reproduce`
 MAX_LINES = 400
 #: Modules allowed over MAX_LINES, with the reason (keep this empty if possible).
@@ -113,8 +113,8 @@ def test_the_core_names_upper_layers_only_at_declared_plugin_points():
             if m.group(0).strip("'\"") not in PLUGIN_POINTS.get(name, set()):
                 bad.append(f"{path.relative_to(ROOT)}: {m.group(0)}")
     assert not bad, "\n".join(bad)
-    from assocopt import models
-    assert models.COST_LAYER in PLUGIN_POINTS["assocopt.models"]
+    from assocopt.workflow import models
+    assert models.COST_LAYER in PLUGIN_POINTS["assocopt.workflow.models"]
 
 
 def test_no_module_is_over_the_size_limit():
@@ -127,8 +127,8 @@ def test_no_module_is_over_the_size_limit():
 
 
 def test_each_concept_is_found_by_file_name():
-    for rel in ("formulation.py", "solvers/highs.py", "tracking/costs/kld.py",
-                "tracking/scenarios/lu2013.py", "lp_fixing.py", "io/mps_lp.py",
+    for rel in ("model/formulation.py", "solvers/highs.py", "tracking/costs/kld.py",
+                "tracking/scenarios/lu2013.py", "solving/lp_fixing.py", "io/mps_lp.py",
                 "tracking/localisation/estimate.py", "experiments/store.py",
                 "reproduce/lu2013/__init__.py", "reproduce/zhang2009/__init__.py"):
         assert (PKG / rel).is_file(), rel
@@ -177,7 +177,7 @@ def test_no_reference_to_files_the_project_does_not_ship():
 
 def test_a_plain_model_does_not_load_the_tracking_layer():
     """The cost layer is looked up only for models with a [cost] table."""
-    code = ("import sys, assocopt.models as m; m.load_model('highs-ilp');"
+    code = ("import sys, assocopt.workflow.models as m; m.load_model('highs-ilp');"
             "print(any(k.startswith('assocopt.tracking') for k in sys.modules));"
             "m.load_model('lu2013-pattipati');"
             "print(any(k.startswith('assocopt.tracking') for k in sys.modules))")

@@ -9,11 +9,11 @@ import pytest
 
 from assocopt import InvalidProblemError, solve
 from assocopt.tracking.costs import build_costs, build_problem
-from assocopt.errors import AssocoptError
+from assocopt.runtime.errors import AssocoptError
 from assocopt.experiments import trial_seed
 from assocopt.reproduce import PAPERS, list_papers, reproduce
 from assocopt.reproduce import lu2013 as L
-from assocopt import lp_fixing
+from assocopt.solving import lp_fixing
 from assocopt.tracking.scenarios.lu2013 import PAPER_SENSORS_KM, Lu2013
 from assocopt.solvers.bruteforce import enumerate_solutions
 from conftest import rerun_committed

@@ -1,4 +1,4 @@
-"""Named models (assocopt.models): the shipped TOML files, lookup, strict validation."""
+"""Named models (assocopt.workflow.models): the shipped TOML files, lookup, strict validation."""
 
 from __future__ import annotations
 
@@ -11,8 +11,8 @@ import pytest
 from assocopt import AssignmentProblem, Status
 from assocopt.cli import EXIT_BAD_INPUT, EXIT_OK, main
 from assocopt.io import read_instance
-from assocopt.models import (FORMULATIONS, MODEL_PATH_ENV, Model, ModelError, find_model,
-                             list_models, load_model, model_dirs)
+from assocopt.workflow.models import (FORMULATIONS, MODEL_PATH_ENV, Model, ModelError, find_model,
+                                      list_models, load_model, model_dirs)
 from assocopt.solvers import registered
 from assocopt.testing import assert_optimal, assert_valid_bound
 

@@ -124,12 +124,12 @@ def test_cli_unknown_back_end_for_options(capsys):
 
 # ------------------------------------------------------------------ models
 def test_model_options_checked_without_a_trial_solve(tmp_path, monkeypatch):
-    import assocopt.api
-    from assocopt.models import ModelError, load_model
+    import assocopt.solving.api
+    from assocopt.workflow.models import ModelError, load_model
 
     def no_solve(*a, **k):
         raise AssertionError("load_model ran a solve")
-    monkeypatch.setattr(assocopt.api, "solve", no_solve)
+    monkeypatch.setattr(assocopt.solving.api, "solve", no_solve)
     good = tmp_path / "good.toml"
     good.write_text('formulation = "ilp"\nsolver = "bnb"\n[options]\nmax_nodes = 10\n')
     assert load_model(str(good)).options["max_nodes"] == 10

@@ -18,7 +18,7 @@ from hypothesis import given, settings, strategies as st
 
 from assocopt import AssignmentProblem, Status, solve
 from assocopt.solvers import registered
-from assocopt.scaling import SCALE_ABOVE
+from assocopt.solvers.scaling import SCALE_ABOVE
 from assocopt.solvers.bruteforce import enumerate_solutions
 
 EXACT = sorted(n for n, c in registered().items()

@@ -13,7 +13,7 @@ import numpy as np
 import pytest
 
 from assocopt.io import jsonable, write_json_atomically, write_text_atomically
-from assocopt.progress import Progress
+from assocopt.runtime.progress import Progress
 
 ROOT = Path(__file__).resolve().parents[1]
 
@@ -140,10 +140,10 @@ def test_no_other_figure_writer_in_the_reproductions():
 
 
 def test_finite_floats_names_the_input_and_raises_the_callers_error():
-    from assocopt.errors import InvalidProblemError
+    from assocopt.runtime.errors import InvalidProblemError
     from assocopt.tracking.group_matching import InvalidObservationsError, Observations
     from assocopt.tracking.gating import gate
-    from assocopt.validation import finite_floats
+    from assocopt.problems.validation import finite_floats
     out = finite_floats([[1, 2]], "x")
     assert out.dtype == np.float64 and out.tolist() == [[1.0, 2.0]]
     with pytest.raises(InvalidProblemError, match="^x contains NaN or inf$"):

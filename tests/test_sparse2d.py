@@ -156,7 +156,7 @@ def _mwfbm_objective(p: AssignmentProblem) -> float:
 
 @pytest.mark.parametrize("n, k, cols", [(3000, 5, None), (2000, 12, 2500), (2500, 3, 1800)])
 def test_gated_scans_match_scipy_lapjvsp(n, k, cols):
-    from assocopt.generate import gated_2d
+    from assocopt.workflow.generate import gated_2d
 
     p = gated_2d(n, k, seed=1, n_cols=cols)
     sol = solve(p)
@@ -167,7 +167,7 @@ def test_gated_scans_match_scipy_lapjvsp(n, k, cols):
 
 def _diagonal_scan(n: int):
     """A gated scan plus the pairs ``(i, i)``: feasible whatever misses are forbidden."""
-    from assocopt.generate import gated_2d
+    from assocopt.workflow.generate import gated_2d
 
     rows, cols, w, _, rm, cm, _, _ = sparse2d.split_candidates(gated_2d(n, 4, seed=2))
     off = rows != cols

@@ -10,7 +10,7 @@ import pytest
 from assocopt import solve
 from assocopt.tracking.costs import kld as dv
 from assocopt.tracking.costs.sd_builder import Scan, build_costs, build_problem, tuple_geometry
-from assocopt.errors import InvalidProblemError
+from assocopt.runtime.errors import InvalidProblemError
 from assocopt.tracking.azimuth import (azimuth_pseudo_measurements, azimuths,
                                        localise_azimuths)
 from assocopt.tracking.sd_gating import build_gated_problem

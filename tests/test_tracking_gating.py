@@ -11,7 +11,7 @@ from hypothesis import given, strategies as st
 from scipy.stats import chi2
 
 from assocopt import solve
-from assocopt.errors import InvalidProblemError
+from assocopt.runtime.errors import InvalidProblemError
 from assocopt.tracking.costs import kinematic as kin
 from assocopt.tracking.gating import gate, pair_statistics, predict_measurements
 from conftest import fresh_python
@@ -189,7 +189,7 @@ def test_empty_scans():
 
 
 def test_the_core_never_imports_tracking():
-    code = ("import sys, assocopt, assocopt.api, assocopt.problem, assocopt.solvers, "
+    code = ("import sys, assocopt, assocopt.solving.api, assocopt.problems.problem, assocopt.solvers, "
             "assocopt.io, assocopt.cli; "
             "print(any(m.startswith('assocopt.tracking') for m in sys.modules))")
     assert fresh_python(code).strip() == "False"

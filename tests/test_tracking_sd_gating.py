@@ -9,7 +9,7 @@ import pytest
 from hypothesis import given, strategies as st
 
 from assocopt.tracking.costs.sd_builder import candidate_tuples, tuple_costs, tuple_geometry
-from assocopt.errors import InvalidProblemError
+from assocopt.runtime.errors import InvalidProblemError
 from assocopt.tracking.localisation import angles
 from assocopt.tracking.scenarios.lu2013 import Lu2013
 from assocopt.tracking.sd_gating import bearing_pair_gate, build_gated_problem, gated_tuples

@@ -101,7 +101,7 @@ def test_dense_solve_does_not_build_the_candidate_list():
 
 
 def test_gated_candidate_list_is_solved_sparse():
-    from assocopt.generate import gated_2d
+    from assocopt.workflow.generate import gated_2d
 
     p = gated_2d(3000, 5, seed=0)
     sol = solve(p)

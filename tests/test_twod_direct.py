@@ -16,9 +16,9 @@ import pytest
 from hypothesis import HealthCheck, given, settings, strategies as st
 
 from assocopt import AssignmentProblem, Status, solve
-from assocopt import api
+from assocopt.solving import api
 from assocopt.solvers import direct2d
-from assocopt.values import _as_matrix
+from assocopt.problems.values import _as_matrix
 
 
 def _general(problem: AssignmentProblem, monkeypatch) -> object:

@@ -12,7 +12,7 @@ import numpy as np
 import pytest
 
 from assocopt import AssignmentProblem, solve
-from assocopt.errors import InvalidProblemError
+from assocopt.runtime.errors import InvalidProblemError
 
 
 def _reference_amax(*arrays: np.ndarray) -> float:

@@ -11,7 +11,7 @@ import numpy as np
 import pytest
 
 from assocopt import solve
-from assocopt.errors import AssocoptError
+from assocopt.runtime.errors import AssocoptError
 from assocopt.reproduce import PAPERS, list_papers, reproduce
 from assocopt.tracking.decide.max_degree import assignment_rule
 from assocopt.tracking.decide.multi_node import three_node_decision, three_node_problem

@@ -10,7 +10,7 @@ import argparse
 import sys
 from typing import Sequence, TextIO
 
-from ..errors import AssocoptError
+from ..runtime.errors import AssocoptError
 from .common import (EXIT_BAD_INPUT, EXIT_BROKEN_PIPE, EXIT_INTERNAL, EXIT_INTERRUPTED,
                      _error, _one_line, _os_message, _UsageError)
 from .parser import _build_parser

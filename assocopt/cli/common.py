@@ -10,7 +10,7 @@ from __future__ import annotations
 import math
 from typing import Any, Sequence, TextIO
 
-from ..solution import Solution, Status
+from ..model.solution import Solution, Status
 
 EXIT_OK = 0
 EXIT_INFEASIBLE = 1
@@ -76,7 +76,7 @@ def _gap_text(g: float | None) -> str:
 def _matches(objective: float | None, optimum: float | None) -> bool | None:
     if optimum is None or objective is None:
         return None
-    from ..problem import OPT_TOL      # imported here: the CLI starts without scipy
+    from ..problems.problem import OPT_TOL      # imported here: the CLI starts without scipy
     return abs(objective - optimum) <= OPT_TOL * max(1.0, abs(optimum))
 
 

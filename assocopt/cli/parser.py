@@ -128,7 +128,7 @@ def _add_input_args(p: argparse.ArgumentParser, formats: Sequence[str]) -> None:
 
 def _add_more_parsers(sub: Any, formats: Sequence[str]) -> None:
     from ..io.convert import CONVERT_FORMATS
-    from ..generate import GENERATORS
+    from ..workflow.generate import GENERATORS
 
     pm = sub.add_parser("models", help="list the named models",
                         description="List the named models (TOML files) found by stem.")

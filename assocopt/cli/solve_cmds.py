@@ -2,7 +2,7 @@
 
 Each ``_cmd_*`` takes the parsed arguments and the output / error streams and returns an
 exit code; library modules are imported inside the functions (as before the split) so that
-``assocopt --help`` stays fast and tests can patch e.g. ``assocopt.api.solve``.
+``assocopt --help`` stays fast and tests can patch e.g. ``assocopt.solving.api.solve``.
 """
 
 from __future__ import annotations
@@ -13,7 +13,7 @@ import json
 from pathlib import Path
 from typing import Any, TextIO
 
-from ..errors import AssocoptError
+from ..runtime.errors import AssocoptError
 from .common import (EXIT_BAD_INPUT, EXIT_INFEASIBLE, EXIT_INTERNAL, EXIT_LIMIT, EXIT_OK, _error, _human,
                      _matches, _num, _one_line, _os_message, _solve_record, _table, exit_code)
 
@@ -32,7 +32,7 @@ def _instance_path(text: str) -> str:
     (``assocopt solve example-sd`` works from any folder, installed or not)."""
     if Path(text).exists():
         return text
-    from ..generate import find_stored_instance
+    from ..workflow.generate import find_stored_instance
 
     stored = find_stored_instance(text)
     return str(stored) if stored is not None else text
@@ -40,8 +40,8 @@ def _instance_path(text: str) -> str:
 
 def _one_shot(problem: Any, relax: str | None) -> Any:
     """The exact answer by enumeration for a tiny S-D problem, or None (see above)."""
-    from ..api import solve
-    from ..solution import Status
+    from ..solving.api import solve
+    from ..model.solution import Status
 
     if relax is not None or problem.ndim < 3 or problem.n_candidates > ONE_SHOT_CANDIDATES:
         return None
@@ -57,7 +57,7 @@ def _one_shot(problem: Any, relax: str | None) -> Any:
 def _compile_note(problem: Any, solver: str, relax: str | None, err: TextIO) -> bool:
     """Start a line on stderr before ``bnb``'s numba kernels are compiled (first run
     only); :func:`_compile_done` ends it with the time taken.  True if begun."""
-    from ..api import choose_solver
+    from ..solving.api import choose_solver
     from ..solvers import get_backend
 
     name = choose_solver(problem, relax) if solver == "auto" else solver
@@ -73,7 +73,7 @@ def _compile_note(problem: Any, solver: str, relax: str | None, err: TextIO) -> 
 
 def _kbest_note(problem: Any, solver: str, err: TextIO) -> bool:
     """:func:`_compile_note` for the compiled 2-D ranking of ``--kbest``."""
-    from .. import kbest2d
+    from ..ranking import kbest2d
 
     if problem.ndim != 2 or solver not in ("auto", kbest2d.NAME) or not kbest2d.available():
         return False
@@ -104,7 +104,7 @@ def _compile_done(sol: Any, begun: bool, err: TextIO) -> None:
 def _cmd_kbest(args: argparse.Namespace, out: TextIO, err: TextIO) -> int:
     """``solve --kbest K``: the K best solutions, as a table or one JSON object."""
     from ..io import read_instance
-    from ..kbest import kbest
+    from ..ranking.kbest import kbest
 
     for flag in ("model", "relax", "out", "time_limit", "gap", "threads"):
         if getattr(args, flag, None) is not None:
@@ -147,7 +147,7 @@ def _check_options(time_limit: Any = None, mip_gap: Any = None, threads: Any = N
 
 
 def _cmd_solve(args: argparse.Namespace, out: TextIO, err: TextIO) -> int:
-    from ..api import solve
+    from ..solving.api import solve
     from ..io import read_instance, write_solution
 
     if getattr(args, "kbest", None) is not None:
@@ -155,7 +155,7 @@ def _cmd_solve(args: argparse.Namespace, out: TextIO, err: TextIO) -> int:
     _check_options(args.time_limit, args.gap, args.threads)
 
     if args.model is not None:
-        from ..models import load_model
+        from ..workflow.models import load_model
 
         if args.solver is not None:
             raise AssocoptError("give --solver or --model, not both")
@@ -305,7 +305,7 @@ def _cmd_solvers(args: argparse.Namespace, out: TextIO, err: TextIO) -> int:
 
 
 def _cmd_compare(args: argparse.Namespace, out: TextIO, err: TextIO) -> int:
-    from ..compare import compare
+    from ..workflow.compare import compare
 
     _check_options(args.time_limit)
     res = compare(args.files, solvers=args.solvers, models=args.models,
@@ -333,7 +333,7 @@ def _cmd_compare(args: argparse.Namespace, out: TextIO, err: TextIO) -> int:
 
 
 def _validate_one(path: str, args: argparse.Namespace) -> dict[str, Any]:
-    from ..generate import feasibility, prove_optimum
+    from ..workflow.generate import feasibility, prove_optimum
     from ..io import read_instance
 
     rec: dict[str, Any] = {"file": path, "ok": False}

@@ -15,12 +15,12 @@ import sys
 from pathlib import Path
 from typing import Any, Sequence, TextIO
 
-from ..errors import AssocoptError
+from ..runtime.errors import AssocoptError
 from .common import EXIT_OK, _num, _one_line, _table, _UsageError
 
 
 def _cmd_models(args: argparse.Namespace, out: TextIO, err: TextIO) -> int:
-    from ..models import list_models
+    from ..workflow.models import list_models
 
     models = list_models(check_options=args.check)
     if args.json:
@@ -49,7 +49,7 @@ def _cmd_export(args: argparse.Namespace, out: TextIO, err: TextIO) -> int:
 
 
 def _cmd_generate(args: argparse.Namespace, out: TextIO, err: TextIO) -> int:
-    from ..generate import generate, prove_optimum
+    from ..workflow.generate import generate, prove_optimum
     from ..io import write_instance
 
     params: dict[str, Any] = {}
@@ -76,7 +76,7 @@ def _cmd_generate(args: argparse.Namespace, out: TextIO, err: TextIO) -> int:
 
 
 def _cmd_convert(args: argparse.Namespace, out: TextIO, err: TextIO) -> int:
-    from ..generate import prove_optimum
+    from ..workflow.generate import prove_optimum
     from ..io.convert import convert
 
     prove = functools.partial(prove_optimum, time_limit=args.time_limit) if args.prove \
@@ -90,7 +90,7 @@ def _cmd_convert(args: argparse.Namespace, out: TextIO, err: TextIO) -> int:
 
 
 def _cmd_instances(args: argparse.Namespace, out: TextIO, err: TextIO) -> int:
-    from ..generate import catalogue, default_instances_dir, write_index
+    from ..workflow.generate import catalogue, default_instances_dir, write_index
 
     folder = Path(args.dir) if args.dir else default_instances_dir()
     if args.write_index:

@@ -12,7 +12,7 @@ from typing import Any, Callable, Mapping, Sequence
 
 import numpy as np
 
-from ..errors import AssocoptError
+from ..runtime.errors import AssocoptError
 
 __all__ = ["Experiment", "PerMethod", "trial_seed", "setting_key", "StoreMismatchError",
            "TrialError", "SCHEMA_VERSION"]

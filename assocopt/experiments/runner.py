@@ -13,8 +13,8 @@ import time
 from pathlib import Path
 from typing import Any, Callable, Mapping, Sequence
 
-from ..errors import AssocoptError
-from ..progress import Progress
+from ..runtime.errors import AssocoptError
+from ..runtime.progress import Progress
 from .design import Experiment, TrialError, setting_key, trial_seed
 from .store import ResultStore
 
@@ -140,7 +140,7 @@ def run_experiment(exp: Experiment, store: str | Path | ResultStore, *, workers:
 def _run_parallel(exp, st, keys, todo, workers, executor, bar) -> None:
     own = executor is None
     if own:
-        from ..parent_watch import watch_parent
+        from ..runtime.parent_watch import watch_parent
         # workers exit when this process dies, even by SIGKILL (see parent_watch)
         executor = cf.ProcessPoolExecutor(max_workers=workers,
                                           mp_context=multiprocessing.get_context("spawn"),

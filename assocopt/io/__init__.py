@@ -22,7 +22,7 @@ file's content:
 Public-format costs are integers; they are stored as float64.  Every problem in a
 public file is a dense (axial) minimisation problem: :meth:`AssignmentProblem.dense`.
 
-Every malformed file raises :class:`~assocopt.errors.InstanceFormatError` with the
+Every malformed file raises :class:`~assocopt.runtime.errors.InstanceFormatError` with the
 file name and what is wrong in the message.
 
 The package has one module per concept; this ``__init__`` re-exports every name
@@ -57,9 +57,9 @@ so ``from assocopt.io import X`` works as before:
 
 from __future__ import annotations
 
-from ..errors import InstanceFormatError, InvalidProblemError  # noqa: F401
-from ..problem import AssignmentProblem  # noqa: F401
-from ..solution import Solution  # noqa: F401
+from ..runtime.errors import InstanceFormatError, InvalidProblemError  # noqa: F401
+from ..problems.problem import AssignmentProblem  # noqa: F401
+from ..model.solution import Solution  # noqa: F401
 from .balas_saltzman import (_BS_BLOCK, _BS_INSTANCE, _PAIR, _bs_blocks,  # noqa: F401
                              _cube_root_floor, _parse_bs_instance, _read_bs_driver,
                              _read_bs_split)

@@ -14,7 +14,7 @@ from typing import Any
 
 import numpy as np
 
-from ..problem import AssignmentProblem
+from ..problems.problem import AssignmentProblem
 from .common import (_INTEGER, TextFile, _count_error, _cube_root, _dense, _fail,
                      _numbers)
 

@@ -3,7 +3,7 @@
 Every reader (:mod:`.grundel`, :mod:`.balas_saltzman`, :mod:`.orlib`,
 :mod:`.json_format`) and the format detection (:mod:`.detect`) raise their errors
 through :func:`_fail` and parse numbers with the helpers here, so that every
-malformed file gives an :class:`~assocopt.errors.InstanceFormatError` that names
+malformed file gives an :class:`~assocopt.runtime.errors.InstanceFormatError` that names
 the file and, where it can, the line of the bad token.
 """
 
@@ -17,8 +17,8 @@ from typing import Any, Callable, NamedTuple
 
 import numpy as np
 
-from ..errors import InstanceFormatError, InvalidProblemError
-from ..problem import AssignmentProblem
+from ..runtime.errors import InstanceFormatError, InvalidProblemError
+from ..problems.problem import AssignmentProblem
 
 _NUMBER = re.compile(r"^[+-]?(\d+\.?\d*|\.\d+)([eE][+-]?\d+)?$")
 _INTEGER = re.compile(r"^[+-]?\d+$")

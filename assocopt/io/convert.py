@@ -8,8 +8,8 @@ import re
 from pathlib import Path
 from typing import Any, Callable
 
-from ..errors import AssocoptError
-from ..problem import AssignmentProblem
+from ..runtime.errors import AssocoptError
+from ..problems.problem import AssignmentProblem
 from .public_writers import PUBLIC_WRITERS, write_public
 
 __all__ = ["CONVERT_FORMATS", "convert", "output_format"]
@@ -42,7 +42,7 @@ def convert(src: str | os.PathLike[str], dst: str | os.PathLike[str], *,
     Converting to JSON keeps the recorded optimum and its source and adds a
     description naming the source file.  ``prove``, when given, proves the optimum of
     the problem read and returns it with how it was proven (``assocopt convert
-    --prove`` passes :func:`assocopt.generate.prove_optimum`, HiGHS); the result is
+    --prove`` passes :func:`assocopt.workflow.generate.prove_optimum`, HiGHS); the result is
     checked against a recorded optimum and recorded.  Returns a summary.
     """
     from .detect import read_instance

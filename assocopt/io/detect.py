@@ -13,8 +13,8 @@ import re
 from pathlib import Path
 from typing import Any
 
-from ..errors import InstanceFormatError
-from ..problem import AssignmentProblem
+from ..runtime.errors import InstanceFormatError
+from ..problems.problem import AssignmentProblem
 from .balas_saltzman import _BS_BLOCK, _read_bs_driver, _read_bs_split
 from .common import (_INTEGER, TextFile, _cube_root, _fail, _first_non_number,
                      _locate_token, _read_text)

@@ -11,7 +11,7 @@ import math
 import re
 from pathlib import Path
 
-from ..problem import AssignmentProblem
+from ..problems.problem import AssignmentProblem
 from .common import (_NUMBER, TextFile, _count_error, _dense, _fail, _header_int,
                      _listed_optimum, _numbers)
 

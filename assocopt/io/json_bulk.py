@@ -26,7 +26,7 @@ from typing import Any, Sequence
 
 import numpy as np
 
-from ..validation import MAX_ABS_COST
+from ..problems.validation import MAX_ABS_COST
 
 #: Spellings of a forbidden (``+inf``) cost as a JSON string (after strip + lower).
 INF_WORDS = frozenset({"inf", "+inf", "infinity", "+infinity"})

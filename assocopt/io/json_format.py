@@ -15,9 +15,9 @@ from typing import Any, Iterable
 
 import numpy as np
 
-from ..errors import InvalidProblemError
-from ..problem import AssignmentProblem
-from ..validation import MAX_ABS_COST
+from ..runtime.errors import InvalidProblemError
+from ..problems.problem import AssignmentProblem
+from ..problems.validation import MAX_ABS_COST
 from .common import MAX_JSON_DEPTH, _fail
 from .json_bulk import INF_WORDS, bulk_costs, bulk_indices
 from .json_scan import JsonScan, scan_json

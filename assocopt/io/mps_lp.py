@@ -1,6 +1,6 @@
 """Export the ILP / LP of a problem as an MPS or LP file, and solve such a file back.
 
-:func:`export_model` writes the model of :mod:`assocopt.formulation` through highspy
+:func:`export_model` writes the model of :mod:`assocopt.model.formulation` through highspy
 (``Highs.writeModel``), so any MILP solver can read it.  Columns are named after
 their candidate tuple, ``x_<i1>_<i2>_..`` (S-D convention: 0 = dummy, real indices
 1-based); rows ``cover_<axis>_<index>`` (axis 0-based, index 1-based), one per real
@@ -17,8 +17,8 @@ from typing import Any
 
 import numpy as np
 
-from ..errors import AssocoptError, InvalidProblemError
-from ..problem import AssignmentProblem
+from ..runtime.errors import AssocoptError, InvalidProblemError
+from ..problems.problem import AssignmentProblem
 from .writers import replace_atomically
 
 __all__ = ["MODEL_FORMATS", "export_model", "solve_model_file"]
@@ -53,7 +53,7 @@ def export_model(problem: AssignmentProblem, path: str | os.PathLike[str], *,
     """
     import highspy
 
-    from ..formulation import build_model
+    from ..model.formulation import build_model
     from ..solvers.highs import highs_from_model
 
     path = Path(path)

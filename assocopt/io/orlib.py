@@ -8,7 +8,7 @@ from __future__ import annotations
 
 from pathlib import Path
 
-from ..problem import AssignmentProblem
+from ..problems.problem import AssignmentProblem
 from .common import (TextFile, _count_error, _dense, _fail, _header_int, _listed_optimum,
                      _numbers)
 

@@ -12,8 +12,8 @@ from pathlib import Path
 
 import numpy as np
 
-from ..errors import AssocoptError, InvalidProblemError
-from ..problem import AssignmentProblem
+from ..runtime.errors import AssocoptError, InvalidProblemError
+from ..problems.problem import AssignmentProblem
 from .writers import replace_atomically
 
 __all__ = ["PUBLIC_WRITERS", "write_public"]

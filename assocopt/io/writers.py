@@ -20,8 +20,8 @@ from typing import Any
 
 import numpy as np
 
-from ..problem import AssignmentProblem
-from ..solution import Solution
+from ..problems.problem import AssignmentProblem
+from ..model.solution import Solution
 from .json_format import instance_to_json
 
 

@@ -18,7 +18,7 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any, Callable, Mapping
 
-from ..errors import AssocoptError
+from ..runtime.errors import AssocoptError
 from . import dong2015, lu2013, xue1999, yan2010, zhang2009
 
 __all__ = ["PAPERS", "Paper", "list_papers", "reproduce", "run"]

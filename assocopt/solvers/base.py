@@ -3,8 +3,8 @@
 A back end is a class with a ``name``, capability flags, ``is_available()`` (checked
 without importing the package), ``version()`` and ``solve(problem, options)``, which
 returns a :class:`RawResult` in terms of candidate positions.  Turning that into a
-:class:`~assocopt.solution.Solution` (recomputing the objective, checking
-feasibility, timing) is done once, in :mod:`assocopt.api`, for every back end.
+:class:`~assocopt.model.solution.Solution` (recomputing the objective, checking
+feasibility, timing) is done once, in :mod:`assocopt.solving.api`, for every back end.
 """
 
 from __future__ import annotations
@@ -20,10 +20,10 @@ from typing import Any, ClassVar
 
 import numpy as np
 
-from ..errors import (InvalidProblemError, SolverCapabilityError, SolverNotInstalledError,
-                      UnknownSolverError)
-from ..problem import AssignmentProblem
-from ..solution import Status
+from ..runtime.errors import (InvalidProblemError, SolverCapabilityError, SolverNotInstalledError,
+                              UnknownSolverError)
+from ..problems.problem import AssignmentProblem
+from ..model.solution import Status
 from .options import COMMON_OPTIONS, Option, check_common, options_table, parse_options
 
 __all__ = ["SolveOptions", "RawResult", "Backend", "register", "declare", "get_backend",

@@ -30,7 +30,7 @@ answer is still a proven optimum.  Problems too large for the kernels' dense 2-D
 matrices (:data:`MAX_DENSE`, :data:`MAX_KEPT`) go there directly.  The compiled part runs in a worker thread that stops
 it at the time limit (with its incumbent and bound: ``TIME_LIMIT``, no fallback) or on
 Ctrl-C, within one ascent iteration or 1024 search nodes.  ``solver="auto"`` uses this back end for small N >= 3
-problems (see :func:`assocopt.api.choose_solver`).
+problems (see :func:`assocopt.solving.api.choose_solver`).
 
 Options (all recorded in ``info["parameters"]``): ``max_iter`` (100) subgradient
 iterations; ``probe_every`` (15) iterations between short searches (0: none);
@@ -67,10 +67,10 @@ from typing import Any
 
 import numpy as np
 
-from ..errors import ProblemTooLargeError
-from ..problem import AssignmentProblem
-from ..solution import Status
-from ..problem import OPT_TOL
+from ..runtime.errors import ProblemTooLargeError
+from ..problems.problem import AssignmentProblem
+from ..model.solution import Status
+from ..problems.problem import OPT_TOL
 from .base import (Backend, Option, RawResult, SolveOptions, _distribution_version,
                    empty_answer, get_backend, register)
 from .interruptible import new_stop, run_stoppable

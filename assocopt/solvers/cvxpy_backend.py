@@ -33,10 +33,10 @@ from typing import Any
 
 import numpy as np
 
-from ..errors import InvalidProblemError, SolverCapabilityError, SolverNotInstalledError
-from ..formulation import build_model
-from ..problem import AssignmentProblem
-from ..solution import Status, relative_gap
+from ..runtime.errors import InvalidProblemError, SolverCapabilityError, SolverNotInstalledError
+from ..model.formulation import build_model
+from ..problems.problem import AssignmentProblem
+from ..model.solution import Status, relative_gap
 from .base import (Backend, Option, RawResult, SolveOptions, empty_answer, register,
                    remaining)
 from .interruptible import run_cancellable

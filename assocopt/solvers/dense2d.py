@@ -39,7 +39,7 @@ import time
 import numpy as np
 from scipy.optimize import linear_sum_assignment as _scipy_lsa
 
-from ..solution import Status
+from ..model.solution import Status
 from .base import RawResult, empty_answer
 from .lap import LapInfeasibleError, augmented_matrix, linear_assignment
 from .sparse2d import (assign_sparse_edges, prefer_sparse, selected_from_edges,

@@ -14,7 +14,7 @@ options, costs in the unscaled range:
   ``min(C - rm - cm, 0)`` of :mod:`assocopt.solvers.dense2d`, split and priced on
   Python lists (for a scan's few rows each numpy call costs more than the work);
 * any other: :func:`~assocopt.solvers.dense2d.assign_dense` and
-  :meth:`~assocopt.twod.Dense2D.check`, as the general route does.
+  :meth:`~assocopt.problems.twod.Dense2D.check`, as the general route does.
 
 The answer is re-checked as the general route re-checks it (distinct columns in range,
 no forbidden pair or miss used) and priced by exact summation (``math.fsum``), so the
@@ -31,10 +31,10 @@ import time
 import numpy as np
 from scipy.optimize import linear_sum_assignment as _lsa
 
-from ..scaling import SCALE_ABOVE      # beyond it the general route answers
-from ..solution import Solution, Status
-from ..twod import Checked
-from ..twod_tables import _index_set, _pair_base, _row_offsets, _tuple_table
+from .scaling import SCALE_ABOVE      # beyond it the general route answers
+from ..model.solution import Solution, Status
+from ..problems.twod import Checked
+from ..problems.twod_tables import _index_set, _pair_base, _row_offsets, _tuple_table
 from .dense2d import assign_dense
 from .lap import LapInfeasibleError
 

@@ -14,8 +14,8 @@ import time
 
 import numpy as np
 
-from ..problem import AssignmentProblem
-from ..solution import Status
+from ..problems.problem import AssignmentProblem
+from ..model.solution import Status
 from .base import Backend, RawResult, SolveOptions, register
 
 __all__ = ["GreedyBackend", "greedy_select", "take_in_order"]

@@ -1,6 +1,6 @@
 """HiGHS through highspy, directly (no scipy layer): the default exact back end.
 
-The CSR model of :mod:`assocopt.formulation` is passed in one ``passModel`` call.
+The CSR model of :mod:`assocopt.model.formulation` is passed in one ``passModel`` call.
 Extra keyword options are passed to HiGHS by name (``presolve="off"``,
 ``mip_heuristic_effort=0.1``...); an unknown HiGHS option is an error.
 """
@@ -13,10 +13,10 @@ from typing import Any
 
 import numpy as np
 
-from ..errors import InvalidProblemError
-from ..formulation import LinearModel, build_model
-from ..problem import AssignmentProblem
-from ..solution import Status
+from ..runtime.errors import InvalidProblemError
+from ..model.formulation import LinearModel, build_model
+from ..problems.problem import AssignmentProblem
+from ..model.solution import Status
 from .base import Backend, RawResult, SolveOptions, empty_answer, register, remaining
 from .status import from_table, settle_optimal
 

@@ -83,7 +83,7 @@ def linear_assignment(C: np.ndarray, method: str = "auto") -> tuple[np.ndarray, 
     ([0, 1], [1, 0])
     """
     if method == "lapx" and not lapx_available():
-        from ..errors import SolverNotInstalledError
+        from ..runtime.errors import SolverNotInstalledError
         raise SolverNotInstalledError("method 'lapx' needs the Python package 'lapx': "
                                       "pip install lapx")
     if method == "lapx" or (method == "auto" and min(C.shape, default=0) >= _LAPX_MIN_N

@@ -6,7 +6,7 @@ dense LAP (:func:`assocopt.solvers.lap.linear_assignment`) in place of scipy's.
 
 from __future__ import annotations
 
-from ..problem import AssignmentProblem
+from ..problems.problem import AssignmentProblem
 from .base import Backend, Option, RawResult, SolveOptions, register
 
 __all__ = ["LapjvBackend"]

@@ -12,7 +12,7 @@ values with the defaults filled in; :func:`assocopt.solve` records them in
 checked by :func:`check_common`, the one place that does it.
 
 The same declarations feed ``assocopt solvers --options NAME``, the checks of model
-files (:mod:`assocopt.models`) and the page ``docs/solver-options.md``
+files (:mod:`assocopt.workflow.models`) and the page ``docs/solver-options.md``
 (:func:`assocopt.solvers.base.options_page`, which lists the registry).  This module
 reads a back end's declaration only, never the registry.
 
@@ -35,7 +35,7 @@ from typing import Any, Iterable, Mapping, Protocol
 
 import numpy as np
 
-from ..errors import InvalidProblemError
+from ..runtime.errors import InvalidProblemError
 
 __all__ = ["Option", "OptionError", "COMMON_OPTIONS", "COMMON_NAMES", "parse_options",
            "check_common", "options_table"]
@@ -220,7 +220,7 @@ def parse_options(backend: type[Declaring], given: Mapping[str, Any]) -> dict[st
     """``given`` checked against ``backend.options``: every declared option with its
     value or default, plus any names the back end passes through to its solver.
 
-    Raises :class:`OptionError` (an :class:`~assocopt.errors.InvalidProblemError`) for
+    Raises :class:`OptionError` (an :class:`~assocopt.runtime.errors.InvalidProblemError`) for
     an unknown name or a bad value, with one wording for every back end.
     """
     declared, defaults, mutable = _declared(backend)

@@ -1,6 +1,6 @@
 """OR-Tools ``model_builder``: SCIP (or another MIP solver) for the ILP, GLOP for the LP.
 
-The CSR model of :mod:`assocopt.formulation` goes into the model in one
+The CSR model of :mod:`assocopt.model.formulation` goes into the model in one
 ``fill_model_from_sparse_data`` call (bounds, costs, row bounds and the matrix from
 numpy), and the solution comes back as one numpy array (``variable_values``).  We
 use the two pybind helpers of ``ortools.linear_solver.python.model_builder``
@@ -13,7 +13,7 @@ Extra options:
                 ``"cbc"``, ``"highs"``, ``"sat"``, ``"gurobi"``, ``"xpress"``.  LP:
                 ``"glop"`` (default), ``"pdlp"``, ``"clp"``, ``"highs"``, ``"scip"``,
                 ``"gurobi"``, ``"xpress"``.  One this OR-Tools build lacks raises
-                :class:`~assocopt.errors.SolverNotInstalledError` (CBC and CLP are not in
+                :class:`~assocopt.runtime.errors.SolverNotInstalledError` (CBC and CLP are not in
                 the 9.15 wheels).  PDLP is a first-order method: its LP optimum is
                 accurate to about 1e-6 relative, not to simplex precision.
 ``parameters``  solver-specific parameter text appended to what assocopt sets
@@ -32,10 +32,10 @@ from typing import Any, Iterator
 
 import numpy as np
 
-from ..errors import InvalidProblemError, SolverNotInstalledError
-from ..formulation import build_model
-from ..problem import AssignmentProblem
-from ..solution import Status, relative_gap
+from ..runtime.errors import InvalidProblemError, SolverNotInstalledError
+from ..model.formulation import build_model
+from ..problems.problem import AssignmentProblem
+from ..model.solution import Status, relative_gap
 from .base import Backend, Option, RawResult, SolveOptions, register, remaining
 from .status import from_table, settle_optimal
 

@@ -13,7 +13,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..problem import AssignmentProblem
+from ..problems.problem import AssignmentProblem
 from .base import Backend, RawResult, SolveOptions, register
 
 __all__ = ["ScipyLsaBackend"]

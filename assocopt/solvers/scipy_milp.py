@@ -11,9 +11,9 @@ import time
 
 import numpy as np
 
-from ..formulation import build_model
-from ..problem import AssignmentProblem
-from ..solution import Status
+from ..model.formulation import build_model
+from ..problems.problem import AssignmentProblem
+from ..model.solution import Status
 from .base import (Backend, Option, RawResult, SolveOptions, empty_answer, register,
                    remaining)
 from .interruptible import run_cancellable

@@ -1,7 +1,7 @@
 """From a solver's own status to assocopt's: the one rule for "optimal, but to a gap".
 
 Each back end maps its solver's native statuses with one table (a dict from the
-native name to :class:`~assocopt.solution.Status`, looked up by :func:`from_table`);
+native name to :class:`~assocopt.model.solution.Status`, looked up by :func:`from_table`);
 :func:`settle_optimal` is the single place that turns an ``OPTIMAL`` claim into
 ``FEASIBLE`` when the solver was allowed to stop at a gap (``mip_gap > 0``) and the gap
 it reached is not zero, or when its own bound contradicts the claim.
@@ -11,8 +11,8 @@ from __future__ import annotations
 
 from typing import Mapping
 
-from ..problem import OPT_TOL
-from ..solution import Status
+from ..problems.problem import OPT_TOL
+from ..model.solution import Status
 
 __all__ = ["GAP_ZERO", "from_table", "settle_optimal"]
 

@@ -25,7 +25,7 @@ from typing import Sequence
 import numpy as np
 from numpy.typing import ArrayLike
 
-from ..errors import InvalidProblemError
+from ..runtime.errors import InvalidProblemError
 from .localisation import COVARIANCES, RCOND_MIN, Localisation, PseudoMeasurements
 
 __all__ = ["azimuths", "localise_azimuths", "azimuth_pseudo_measurements",

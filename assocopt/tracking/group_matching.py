@@ -31,8 +31,8 @@ from numpy.typing import ArrayLike
 
 from .belief import (InvalidMassError, check_vectors, conflict_matrix, conjunctive_vectors,
                      discount_vectors, zhang_combination_vectors, zhang_conflict_matrix)
-from ..errors import AssocoptError
-from ..validation import finite_floats
+from ..runtime.errors import AssocoptError
+from ..problems.validation import finite_floats
 
 __all__ = [
     "MATCH_FRAME", "MEASURES", "SAME_SENSOR_READINGS", "MeasureParams", "Observations",

@@ -30,8 +30,8 @@ import numpy as np
 from numpy.typing import ArrayLike
 
 from .costs.sd_builder import Scan, tuple_costs, tuple_geometry
-from ..errors import InvalidProblemError
-from ..problem import AssignmentProblem
+from ..runtime.errors import InvalidProblemError
+from ..problems.problem import AssignmentProblem
 
 __all__ = ["gated_tuples", "bearing_pair_gate", "build_gated_problem"]
 

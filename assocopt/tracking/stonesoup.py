@@ -3,7 +3,7 @@
 Install with ``pip install assocopt[stonesoup]``.  :class:`AssocoptGNN` is a drop-in
 replacement for Stone Soup's :class:`~stonesoup.dataassociator.neighbour.GNNWith2DAssignment`:
 it takes the same hypothesiser, turns its hypotheses into a sparse 2-D
-:class:`~assocopt.problem.AssignmentProblem` and returns a
+:class:`~assocopt.problems.problem.AssignmentProblem` and returns a
 :class:`~stonesoup.types.hypothesis.JointHypothesis` (a mapping track -> hypothesis)
 from the optimum.  :class:`AssocoptKBest` returns the ``k`` best joint hypotheses
 (Murty's ranking, :func:`assocopt.kbest`).
@@ -38,9 +38,9 @@ except ImportError as exc:  # pragma: no cover - exercised in a subprocess-free 
     raise ImportError("assocopt.tracking.stonesoup needs Stone Soup: "
                       "pip install assocopt[stonesoup]") from exc
 
-from ..api import solve
-from ..problem import AssignmentProblem
-from ..solution import Status
+from ..solving.api import solve
+from ..problems.problem import AssignmentProblem
+from ..model.solution import Status
 
 __all__ = ["AssocoptGNN", "AssocoptKBest", "hypotheses_problem"]
 
@@ -180,7 +180,7 @@ class AssocoptKBest(AssocoptGNN):
 
     def associate_hypotheses(self, hypotheses) -> list:
         """The ``k`` best joint hypotheses of already generated ``hypotheses``."""
-        from .. import kbest
+        from ..ranking import kbest
 
         if isinstance(self.k, bool) or int(self.k) != self.k or self.k < 1:
             raise ValueError(f"k must be a positive integer, got {self.k!r}")

@@ -186,8 +186,8 @@ def _assignment_only(inp, p: TopologyParams) -> dict[str, float]:
     through ``scipy.optimize.linear_sum_assignment`` on the equivalent matrix."""
     from scipy.optimize import linear_sum_assignment
 
-    from ...api import solve
-    from ...problem import AssignmentProblem
+    from ...solving.api import solve
+    from ...problems.problem import AssignmentProblem
     from ...tracking.decide.topology import pair_gammas, thresholds
     thr = thresholds(inp, p)
     n1, n2 = thr.shape

@@ -12,14 +12,14 @@ from typing import Any, Mapping, Sequence
 
 import numpy as np
 
-from ...api import solve
+from ...solving.api import solve
 from ...tracking.costs.sd_builder import COSTS, build_costs, build_problem
 from ...experiments import Experiment, association_metrics
 from ...tracking.scenarios.lu2013 import PAPER, REPRODUCTION_REGION_KM, Lu2013
-from ...problem import AssignmentProblem
-from ...solution import Status
+from ...problems.problem import AssignmentProblem
+from ...model.solution import Status
 from ...solvers.bruteforce import enumerate_solutions
-from ... import lp_fixing
+from ...solving import lp_fixing
 
 __all__ = ["METHODS", "PAPER_TABLES", "PAPER_FIG2_GAIN", "DEFAULTS", "experiments",
            "fig_trial", "table_trial", "parameters", "D_GRID", "TABLE_GRID", "TABLE_COLUMNS",

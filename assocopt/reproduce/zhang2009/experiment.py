@@ -12,10 +12,10 @@ from typing import Any, Mapping, Sequence
 
 import numpy as np
 
-from ...api import choose_solver, solve
+from ...solving.api import choose_solver, solve
 from ...experiments import Experiment
-from ...problem import AssignmentProblem
-from ...solution import Status
+from ...problems.problem import AssignmentProblem
+from ...model.solution import Status
 from ...tracking.decide.md2da import gate_threshold, md_2da, md_2da_problem
 from ...tracking.decide.truncation import TruncationOptions, md_nd
 from ...tracking.group_matching import (MeasureParams, Relations, correct_match_rate,

@@ -2,7 +2,7 @@
 ``lagrangian-exact``, the sparse 2-D LAP (:mod:`.sparse_lap`, imported by
 :mod:`assocopt.solvers.sparse2d`) and the 2-D ranking of :func:`assocopt.kbest`
 (:mod:`.sap`: a warm-startable shortest-augmenting-path LAP on dense matrices,
-:mod:`.murty2d`: Murty's method on it, imported by :mod:`assocopt.kbest2d`); imported
+:mod:`.murty2d`: Murty's method on it, imported by :mod:`assocopt.ranking.kbest2d`); imported
 only when one of them runs (importing numba costs half a second).
 :mod:`assocopt.solvers.bnb_kernels` is the import point of the ``bnb`` kernels.
 

@@ -2,7 +2,7 @@
 duals by one shortest augmenting path; compiled with numba.
 
 The matrix ``A`` (``nr x nc``, ``nr <= nc``, ``inf`` = forbidden; every row assigned,
-columns free at no cost) is a 2-D problem in LAP form (:mod:`assocopt.kbest2d` builds
+columns free at no cost) is a 2-D problem in LAP form (:mod:`assocopt.ranking.kbest2d` builds
 it); its first ``P`` rows are the *real* rows, whose choices of column define a 2-D
 solution, any others are dummy rows whose assignment follows from the real rows' (up to
 equal-cost permutations among zero-cost dummy entries).  Murty's partition is taken

@@ -14,8 +14,8 @@ from typing import Any, Callable
 
 import numpy as np
 
-from ...problem import AssignmentProblem
-from ...solution import Status
+from ...problems.problem import AssignmentProblem
+from ...model.solution import Status
 from ..base import Backend, RawResult, SolveOptions, register
 from ..kernels import spent
 from ..lap import LapInfeasibleError

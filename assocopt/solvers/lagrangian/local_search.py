@@ -11,7 +11,7 @@ import math
 
 import numpy as np
 
-from ...problem import OPT_TOL
+from ...problems.problem import OPT_TOL
 from ..lap import LapInfeasibleError, assign_with_misses
 
 

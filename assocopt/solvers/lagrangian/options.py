@@ -4,15 +4,15 @@ Kept apart from the algorithm so that the option set (documented in the package
 docstring) can be read in one place.  Values are checked by the one parser of
 :mod:`assocopt.solvers.options`; :func:`check_engines` adds the one check that
 depends on what is installed.  :data:`OPT_TOL` and the kept-axes rule live in
-:mod:`assocopt.problem` and are re-exported here.
+:mod:`assocopt.problems.problem` and are re-exported here.
 """
 
 from __future__ import annotations
 
 from typing import Any
 
-from ...errors import SolverNotInstalledError
-from ...problem import OPT_TOL, kept_axes
+from ...runtime.errors import SolverNotInstalledError
+from ...problems.problem import OPT_TOL, kept_axes
 from ..lap import LAP_METHODS, lapx_available
 from ..options import Option
 
@@ -82,7 +82,7 @@ def _parse(extra: dict[str, Any], exact: bool, name: str) -> dict[str, Any]:
 
 
 def _keep_axes(sizes: tuple[int, ...], keep: Any) -> tuple[int, int]:
-    """The two kept axes (see :func:`assocopt.problem.kept_axes`)."""
+    """The two kept axes (see :func:`assocopt.problems.problem.kept_axes`)."""
     return kept_axes(sizes, keep)
 
 

@@ -13,8 +13,8 @@ from typing import Any
 
 import numpy as np
 
-from ...errors import InvalidProblemError
-from ...problem import AssignmentProblem
+from ...runtime.errors import InvalidProblemError
+from ...problems.problem import AssignmentProblem
 from ..lap import (Assignment2D, LapInfeasibleError, assign_with_misses, assignment_duals,
                    linear_assignment)
 

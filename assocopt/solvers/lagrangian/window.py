@@ -16,7 +16,7 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
-from ...problem import AssignmentProblem
+from ...problems.problem import AssignmentProblem
 from ..base import SolveOptions, module_installed
 from .ascent import _State
 from .options import OPT_TOL
@@ -217,7 +217,7 @@ def _ilp(problem: AssignmentProblem, pos: np.ndarray, st: _State, options: Solve
     """
     import highspy
 
-    from ...formulation import LinearModel
+    from ...model.formulation import LinearModel
     from ..highs import highs_from_model, run_highs
 
     K = len(pos)

@@ -17,7 +17,7 @@ from collections.abc import Hashable, Iterable, Mapping
 import numpy as np
 from numpy.typing import ArrayLike
 
-from ...errors import AssocoptError
+from ...runtime.errors import AssocoptError
 
 #: Largest frame stored as a dense vector of 2**n masses.
 MAX_FRAME_SIZE = 20

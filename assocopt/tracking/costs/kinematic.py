@@ -39,8 +39,8 @@ from __future__ import annotations
 import numpy as np
 from numpy.typing import ArrayLike
 
-from ...errors import InvalidProblemError
-from ...problem import AssignmentProblem
+from ...runtime.errors import InvalidProblemError
+from ...problems.problem import AssignmentProblem
 from ..gating import Gate, gate as make_gate
 
 __all__ = ["COSTS", "mahalanobis_costs", "nllr_costs", "nllr_miss_cost", "gated_problem",

@@ -31,7 +31,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from ...errors import InvalidProblemError
+from ...runtime.errors import InvalidProblemError
 from ..localisation import wrap_angle
 
 __all__ = ["NORMALISATIONS", "measurement_constant", "dummy_constant",

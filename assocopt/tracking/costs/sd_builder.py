@@ -14,7 +14,7 @@ Pipeline, all vectorised over the K candidate tuples at once (no loop per tuple)
 2. :func:`tuple_geometry` -- LS position (14) and covariance (15) of every tuple with
    >= 2 real measurements, and its pseudo-measurement statistics (22)-(23);
 3. :func:`tuple_costs` -- the cost of each tuple for one named method (:data:`COSTS`);
-4. :func:`build_problem` -- an :class:`~assocopt.problem.AssignmentProblem`.
+4. :func:`build_problem` -- an :class:`~assocopt.problems.problem.AssignmentProblem`.
 
 :func:`build_costs` does steps 1-3 for several methods sharing one geometry.
 """
@@ -27,9 +27,9 @@ from typing import Sequence
 import numpy as np
 from numpy.typing import ArrayLike
 
-from ...errors import InvalidProblemError
+from ...runtime.errors import InvalidProblemError
 from ..localisation import localise_indexed, pseudo_measurements
-from ...problem import AssignmentProblem
+from ...problems.problem import AssignmentProblem
 from .data_terms import TupleGeometry, data_term
 from .pattipati import NORMALISATIONS, constant_terms
 

@@ -37,8 +37,8 @@ from dataclasses import asdict, dataclass
 import numpy as np
 from scipy.stats import chi2
 
-from ...api import solve
-from ...problem import AssignmentProblem
+from ...solving.api import solve
+from ...problems.problem import AssignmentProblem
 from ..costs.association_degree import DegreeParams, feature_degrees, fused_degree
 
 __all__ = ["RULES", "ASSIGNMENT_COSTS", "COUNTER_SEMANTICS", "DecisionOptions",

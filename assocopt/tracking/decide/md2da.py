@@ -46,10 +46,10 @@ from typing import Any
 import numpy as np
 from numpy.typing import ArrayLike
 
-from ...api import solve
+from ...solving.api import solve
 from ..group_matching import MeasureParams, Relations, pair_measure
-from ...problem import AssignmentProblem
-from ...solution import Solution, Status
+from ...problems.problem import AssignmentProblem
+from ...model.solution import Solution, Status
 from .truncation import check_pi
 
 __all__ = ["COSTS", "MD2DAResult", "md_2da_problem", "md_2da", "gate_threshold"]

@@ -21,8 +21,8 @@ from __future__ import annotations
 
 import numpy as np
 
-from ...api import solve
-from ...problem import AssignmentProblem
+from ...solving.api import solve
+from ...problems.problem import AssignmentProblem
 
 __all__ = ["three_node_problem", "three_node_decision"]
 

@@ -27,9 +27,9 @@ from typing import Any
 import numpy as np
 from numpy.typing import ArrayLike
 
-from ...api import solve
-from ...problem import AssignmentProblem
-from ...solution import Status
+from ...solving.api import solve
+from ...problems.problem import AssignmentProblem
+from ...model.solution import Status
 
 __all__ = ["gnn_assign", "nearest_neighbour", "check_costs"]
 

@@ -45,8 +45,8 @@ from typing import Any
 
 import numpy as np
 
-from ...api import solve
-from ...problem import AssignmentProblem
+from ...solving.api import solve
+from ...problems.problem import AssignmentProblem
 from ..topology import (check_tracks, chi2_gate, heading_jacobians, heading_variance,
                         pair_distances, reference_frames)
 

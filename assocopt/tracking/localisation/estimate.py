@@ -11,7 +11,7 @@ from typing import Sequence
 import numpy as np
 from numpy.typing import ArrayLike
 
-from ...errors import InvalidProblemError
+from ...runtime.errors import InvalidProblemError
 from .geometry import (COVARIANCES, METHODS, _check_batch, _check_R, _check_sensors, _jac_e,
                        _los, angle_jacobian, angles, wrap_angle)
 

@@ -8,7 +8,7 @@ from __future__ import annotations
 import numpy as np
 from numpy.typing import ArrayLike
 
-from ...errors import InvalidProblemError
+from ...runtime.errors import InvalidProblemError
 
 __all__ = ["angles", "angle_jacobian", "wrap_angle", "los_system", "residual_jacobian",
            "METHODS", "COVARIANCES"]

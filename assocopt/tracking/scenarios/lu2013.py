@@ -22,7 +22,7 @@ from dataclasses import asdict, dataclass
 import numpy as np
 
 from ..costs.sd_builder import Scan
-from ...errors import InvalidProblemError
+from ...runtime.errors import InvalidProblemError
 from ..localisation import angles
 
 __all__ = ["Lu2013", "Truth", "PAPER_SENSORS_KM", "PAPER", "OURS", "REPRODUCTION_REGION_KM"]

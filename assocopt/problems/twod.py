@@ -26,7 +26,7 @@ from typing import Any, NamedTuple
 
 import numpy as np
 
-from .errors import InvalidProblemError
+from ..runtime.errors import InvalidProblemError
 from .validation import MAX_ABS_COST
 from .values import _as_matrix
 from .twod_tables import _finite_amax, _index_set, _pair_base, _row_offsets

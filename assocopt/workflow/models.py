@@ -42,7 +42,7 @@ from pathlib import Path
 from types import MappingProxyType
 from typing import Any, Mapping
 
-from .errors import AssocoptError
+from ..runtime.errors import AssocoptError
 
 __all__ = ["Model", "ModelError", "FORMULATIONS", "COMMON_OPTIONS", "load_model",
            "find_model", "list_models", "model_dirs", "MODEL_PATH_ENV"]
@@ -60,8 +60,8 @@ _COST_KEYS = ("builder", "params")
 _DEFAULT_SOLVER = {"lagrangian": "lagrangian", "lagrangian-exact": "lagrangian-exact",
                    "bruteforce": "bruteforce", "heuristic": "greedy"}
 
-_PACKAGE_MODELS = Path(__file__).resolve().parent / "data" / "models"
-_PROJECT_MODELS = Path(__file__).resolve().parent.parent / "models"
+_PACKAGE_MODELS = Path(__file__).resolve().parents[1] / "data" / "models"
+_PROJECT_MODELS = Path(__file__).resolve().parents[2] / "models"
 
 
 class ModelError(AssocoptError, ValueError):
@@ -124,7 +124,7 @@ class Model:
         >>> load_model("highs-ilp").solve(AssignmentProblem.dense([[4, 1], [2, 3]])).objective
         3.0
         """
-        from .api import solve
+        from ..solving.api import solve
 
         sol = solve(problem, self.solver, **self.solve_kwargs(**overrides))
         sol.info["model"] = self.name
@@ -243,7 +243,7 @@ def _parse_file(path: Path, *, check_options: bool) -> Model:
 
 
 def _from_dict(doc: dict[str, Any], path: Path, *, check_options: bool) -> Model:
-    from .solvers import get_backend, registered
+    from ..solvers import get_backend, registered
 
     for key in doc:
         if key not in _TOP_KEYS:
@@ -303,7 +303,7 @@ def _incompatible(formulation: str, solver: str, cls: Any) -> str | None:
 def _options(raw: Any, path: Path) -> dict[str, Any]:
     """The ``[options]`` table: the common options checked by the one checker of
     :mod:`assocopt.solvers.options`; back-end options must be plain values."""
-    from .solvers.options import COMMON_OPTIONS as DECLARED
+    from ..solvers.options import COMMON_OPTIONS as DECLARED
 
     if not isinstance(raw, dict):
         raise _fail(path, "options", f"must be a table ([options]), found {_type_name(raw)}")
@@ -358,7 +358,7 @@ def _cost(raw: Any, path: Path) -> Mapping[str, Any]:
 
 def _check_backend_options(cls: Any, extras: dict[str, Any], path: Path) -> None:
     """The back end's own options checked against its declaration (no trial solve)."""
-    from .solvers.options import OptionError
+    from ..solvers.options import OptionError
 
     if not cls.is_available() and cls.native_options:
         declared = {o.name for o in cls.options}

@@ -3,7 +3,7 @@
 A problem with axes of sizes ``n_1 .. n_N`` has one coverage constraint ("row") per
 real index: row ``offset_s + i - 1`` stands for real index ``i`` (1-based) of axis
 ``s`` (0-based), ``offset_s = n_1 + ... + n_{s-1}``.  :class:`IndexArithmetic` gives
-:class:`~assocopt.problem.AssignmentProblem` the global row of every tuple entry, the
+:class:`~assocopt.problems.problem.AssignmentProblem` the global row of every tuple entry, the
 coverage matrix (of all candidates or a window of them), the uncovered rows and
 indices, their labels, the kept-axes rule of the Lagrangian relaxations and whether
 the costs are integers; :data:`OPT_TOL` is the one relative tolerance of "a bound
@@ -18,7 +18,7 @@ from typing import TYPE_CHECKING, Any, Sequence
 import numpy as np
 from numpy.typing import ArrayLike
 
-from .errors import InvalidProblemError
+from ..runtime.errors import InvalidProblemError
 from .validation import require_memory
 
 if TYPE_CHECKING:   # pragma: no cover
@@ -58,7 +58,7 @@ def kept_axes(sizes: Sequence[int], keep: Any = None) -> tuple[int, int]:
 
 
 class IndexArithmetic:
-    """Mixin of :class:`~assocopt.problem.AssignmentProblem`: needs ``sizes``,
+    """Mixin of :class:`~assocopt.problems.problem.AssignmentProblem`: needs ``sizes``,
     ``tuples``, ``costs``, ``n_rows`` and ``row_offsets``."""
 
     sizes: tuple[int, ...]

@@ -6,7 +6,7 @@ candidates of the final, small ILP are solved through :func:`assocopt.solve` wit
 exact back end.
 
 * :func:`lp_relaxation` -- the LP relaxation of the S-D set-partitioning
-  model (:mod:`assocopt.formulation`) solved by HiGHS, with its row
+  model (:mod:`assocopt.model.formulation`) solved by HiGHS, with its row
   duals ``u`` and the reduced costs ``d = c - A^T u`` of every candidate (gathered,
   no matrix product).
 * :func:`solve_with_fixing` -- with ``L(u) = sum(u) + sum(min(d, 0))`` (a valid lower
@@ -26,10 +26,10 @@ from dataclasses import dataclass
 import numpy as np
 
 from .api import solve
-from .formulation import build_model
-from .problem import AssignmentProblem
-from .solution import Solution, Status
-from .solvers.greedy import take_in_order
+from ..model.formulation import build_model
+from ..problems.problem import AssignmentProblem
+from ..model.solution import Solution, Status
+from ..solvers.greedy import take_in_order
 
 __all__ = ["LPResult", "lp_relaxation", "lp_relaxations", "solve_with_fixing", "greedy_cover",
            "reduced_costs"]
@@ -72,7 +72,7 @@ def lp_relaxation(prob: AssignmentProblem) -> LPResult | None:
     """Optimum of the LP relaxation with HiGHS (dual simplex, presolve off), with duals.
 
     This is the model :func:`assocopt.solve` builds for ``relax="lp"``
-    (:func:`assocopt.formulation.build_model`) passed to HiGHS directly, because the
+    (:func:`assocopt.model.formulation.build_model`) passed to HiGHS directly, because the
     row duals are needed for fixing.  Returns None if HiGHS does not report optimal.
     """
     return lp_relaxations([prob])[0]
@@ -82,8 +82,8 @@ def lp_relaxations(problems: list[AssignmentProblem]) -> list[LPResult | None]:
     """:func:`lp_relaxation` of several problems.  Consecutive problems with the same
     candidate tuples (same constraints, other costs) reuse one HiGHS model: only the
     costs change and the simplex starts from the previous optimal basis."""
-    from .solvers.base import SolveOptions
-    from .solvers.highs import highs_from_model
+    from ..solvers.base import SolveOptions
+    from ..solvers.highs import highs_from_model
 
     out: list[LPResult | None] = []
     h, prev = None, None

@@ -28,10 +28,10 @@ import math
 
 import numpy as np
 
-from .problem import AssignmentProblem
-from .solution import Status
-from .solvers.base import Backend, RawResult, SolveOptions
-from .twod_tables import _finite_amax
+from ..problems.problem import AssignmentProblem
+from ..model.solution import Status
+from .base import Backend, RawResult, SolveOptions
+from ..problems.twod_tables import _finite_amax
 
 __all__ = ["SCALE_ABOVE", "solve_in_range", "max_abs_cost"]
 

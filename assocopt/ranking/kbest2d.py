@@ -34,8 +34,8 @@ from typing import NamedTuple
 
 import numpy as np
 
-from .problem import AssignmentProblem
-from .solution import Solution, Status
+from ..problems.problem import AssignmentProblem
+from ..model.solution import Solution, Status
 
 __all__ = ["available", "lap_form", "form_entries", "kbest_2d", "NAME"]
 
@@ -114,8 +114,8 @@ def kbest_2d(problem: AssignmentProblem, k: int) -> tuple[list[Solution], bool, 
                                                           dict[str, float]] | None:
     """``(solutions best first, exhausted, subproblems solved, kernel times)`` of a
     2-D problem, or None when it is not for this path (empty side, too large)."""
-    from .solvers.kernels import ensure, spent
-    from .solvers.kernels.murty2d import murty
+    from ..solvers.kernels import ensure, spent
+    from ..solvers.kernels.murty2d import murty
 
     d = problem.dense_view
     n1, n2 = problem.sizes
@@ -195,7 +195,7 @@ def _solutions_dense(problem: AssignmentProblem, cor: np.ndarray) -> list[Soluti
 
 def _solutions_list(problem: AssignmentProblem, cor: np.ndarray) -> list[Solution]:
     """The answers of a problem given as a candidate list (positions looked up)."""
-    from .solvers.dense2d import _answer_positions
+    from ..solvers.dense2d import _answer_positions
 
     out = []
     for c in cor:
@@ -211,7 +211,7 @@ def _solutions_list(problem: AssignmentProblem, cor: np.ndarray) -> list[Solutio
 def _ranked(problem: AssignmentProblem, out: list) -> list[Solution]:
     """Solutions from ``(objective, selected, tuples)``, sorted by objective, then
     ``selected`` (minimisation sense; flipped for a maximisation problem)."""
-    from ._version import __version__
+    from .._version import __version__
 
     objs = [e[0] for e in out]
     if any(a >= b for a, b in zip(objs, objs[1:])):   # ties (or rounding): reorder

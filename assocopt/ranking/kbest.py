@@ -11,8 +11,8 @@ feasible solution exactly once.  Slack candidates (the free surplus of a rectang
 ``dense`` problem) are never split on: the real tuples fix them.
 
 2-D problems (``solver="auto"``, numba installed, a LAP form of at most
-:data:`assocopt.kbest2d.MAX_FORM_ENTRIES` entries) are ranked in one compiled call
-(:mod:`assocopt.kbest2d`, kernel :mod:`assocopt.solvers.kernels.murty2d`): each
+:data:`assocopt.ranking.kbest2d.MAX_FORM_ENTRIES` entries) are ranked in one compiled call
+(:mod:`assocopt.ranking.kbest2d`, kernel :mod:`assocopt.solvers.kernels.murty2d`): each
 subproblem is solved from its parent's solution and duals by one shortest augmenting
 path, children wait on the heap unsolved under a lower bound, and the partition is
 taken over the real rows of a LAP form in which every 2-D solution (misses included)
@@ -44,9 +44,9 @@ from typing import Any, Iterator
 
 import numpy as np
 
-from .errors import InvalidProblemError, SolverCapabilityError
-from .problem import AssignmentProblem
-from .solution import Solution, Status
+from ..runtime.errors import InvalidProblemError, SolverCapabilityError
+from ..problems.problem import AssignmentProblem
+from ..model.solution import Solution, Status
 
 __all__ = ["kbest", "Ranked"]
 
@@ -213,8 +213,8 @@ class _Dense2DSpace(_Space):
             self.slack = bool(problem.slack.any())
 
     def solve(self, forced: tuple, banned: tuple) -> tuple | None:
-        from .solvers.dense2d import assign_dense
-        from .solvers.lap import LapInfeasibleError
+        from ..solvers.dense2d import assign_dense
+        from ..solvers.lap import LapInfeasibleError
 
         C, rm, cm = self.C.copy(), self.rm.copy(), self.cm.copy()
         for i, j in banned:
@@ -245,7 +245,7 @@ class _Dense2DSpace(_Space):
         return self.problem.objective_of(sel), sel, items
 
     def _positions(self, cor: np.ndarray) -> tuple[np.ndarray, list]:
-        from .solvers.dense2d import _answer_positions
+        from ..solvers.dense2d import _answer_positions
 
         d = self.problem.dense_view
         if d is not None:
@@ -270,7 +270,7 @@ class _CandidateSpace(_Space):
     end; an item is a candidate position."""
 
     def __init__(self, problem: AssignmentProblem, solver: str, options: dict) -> None:
-        from .solvers import registered
+        from ..solvers import registered
 
         self.problem, self.solver, self.options = problem, solver, options
         if solver != "auto":
@@ -283,7 +283,7 @@ class _CandidateSpace(_Space):
         self.name = solver
 
     def solve(self, forced: tuple, banned: tuple) -> tuple | None:
-        from .api import solve
+        from ..solving.api import solve
 
         p = self.problem
         mask = np.ones(p.n_candidates, bool)
@@ -313,8 +313,8 @@ class _CandidateSpace(_Space):
 def _solution(problem: AssignmentProblem, sel: np.ndarray, rank: int,
               solver: str) -> Solution:
     """A re-checked :class:`Solution` for the ``rank``-th selection."""
-    from .api import to_user_sense
-    from .solvers import get_backend
+    from ..solving.api import to_user_sense
+    from ..solvers import get_backend
 
     why = problem.violations(sel)
     if why is not None:

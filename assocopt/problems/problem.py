@@ -33,7 +33,7 @@ from typing import Any, Sequence
 import numpy as np
 from numpy.typing import ArrayLike
 
-from .errors import InvalidProblemError
+from ..runtime.errors import InvalidProblemError
 from .indexing import OPT_TOL, IndexArithmetic, index_label, kept_axes
 from .twod import MAX_DENSE_CANDIDATES, LazyView, from_matrix, miss_vector
 from .validation import (MAX_ABS_COST, MAX_SIZE, check_sizes, check_tuples,  # noqa: F401
@@ -104,7 +104,7 @@ class AssignmentProblem(IndexArithmetic):
     optimum: float | None = None
     meta: dict[str, Any] = field(default_factory=dict)
     maximize: bool = False
-    #: The dense 2-D view (:class:`assocopt.twod.Dense2D`) when built from a matrix.
+    #: The dense 2-D view (:class:`assocopt.problems.twod.Dense2D`) when built from a matrix.
     _dense: Any = field(default=None, init=False, repr=False)
 
     # ------------------------------------------------------------------ builders
@@ -181,7 +181,7 @@ class AssignmentProblem(IndexArithmetic):
 
     @property
     def dense_view(self) -> Any:
-        """The :class:`assocopt.twod.Dense2D` of a problem built from a 2-D matrix, else None."""
+        """The :class:`assocopt.problems.twod.Dense2D` of a problem built from a 2-D matrix, else None."""
         return self._dense
 
     @classmethod

@@ -7,13 +7,13 @@ from typing import Any
 
 import numpy as np
 
-from .errors import InvalidProblemError
-from .problem import AssignmentProblem, index_label
-from .solution import Solution, Status
-from .solvers.base import (Backend, RawResult, SolveOptions, check_capabilities,
-                           empty_answer, get_backend, module_installed)
-from .solvers.kernels import spent
-from .scaling import solve_in_range
+from ..runtime.errors import InvalidProblemError
+from ..problems.problem import AssignmentProblem, index_label
+from ..model.solution import Solution, Status
+from ..solvers.base import (Backend, RawResult, SolveOptions, check_capabilities,
+                            empty_answer, get_backend, module_installed)
+from ..solvers.kernels import spent
+from ..solvers.scaling import solve_in_range
 
 __all__ = ["solve", "choose_solver", "BNB_MAX_CANDIDATES"]
 
@@ -45,7 +45,7 @@ def choose_solver(problem: AssignmentProblem, relax: str | None = None) -> str:
 
 
 def _bnb_usable(problem: AssignmentProblem) -> bool:
-    from .solvers.bnb import kept_sizes
+    from ..solvers.bnb import kept_sizes
     return _numba_installed() and sum(kept_sizes(problem)) <= BNB_MAX_KEPT
 
 
@@ -140,7 +140,7 @@ def _direct_path():
     scipy, which ``import assocopt`` does not)."""
     global _DIRECT
     if _DIRECT is None:
-        from .solvers.direct2d import solve_direct
+        from ..solvers.direct2d import solve_direct
         _DIRECT = solve_direct
     return _DIRECT
 

@@ -14,7 +14,7 @@ import math
 import numpy as np
 from numpy.typing import ArrayLike
 
-from .errors import InvalidProblemError
+from ..runtime.errors import InvalidProblemError
 from .validation import MAX_ABS_COST, check_cost_dtype, check_cost_range
 
 __all__ = ["_as_cost_array", "_as_matrix", "_reject_non_finite"]

@@ -26,9 +26,9 @@ import sys
 from dataclasses import dataclass, field
 from typing import Any, Callable, Iterable, Sequence, TextIO
 
-from .errors import AssocoptError, SolverCapabilityError
-from .problem import OPT_TOL, AssignmentProblem
-from .progress import Progress
+from ..runtime.errors import AssocoptError, SolverCapabilityError
+from ..problems.problem import OPT_TOL, AssignmentProblem
+from ..runtime.progress import Progress
 
 __all__ = ["Method", "CompareResult", "compare", "resolve_methods", "TOLERANCE", "COLUMNS"]
 
@@ -50,7 +50,7 @@ class Method:
     kwargs: dict[str, Any] = field(default_factory=dict)
 
     def run(self, problem: AssignmentProblem) -> Any:
-        from .api import solve
+        from ..solving.api import solve
         return solve(problem, self.solver, **self.kwargs)
 
 
@@ -59,7 +59,7 @@ def resolve_methods(solvers: Sequence[str] | None = None, models: Sequence[str] 
                     ) -> list[Method]:
     """Methods for back-end names and/or model names (checked: unknown names raise)."""
     from .models import load_model
-    from .solvers import get_backend
+    from ..solvers import get_backend
 
     methods: list[Method] = []
     for name in solvers or ():
@@ -137,7 +137,7 @@ def _run_one(problem: AssignmentProblem, method: Method, repeat: int) -> dict[st
 def _load(item: Any, fmt: str, instance: Any) -> AssignmentProblem:
     if isinstance(item, AssignmentProblem):
         return item
-    from .io import read_instance
+    from ..io import read_instance
     return read_instance(item, format=fmt, instance=instance)
 
 
@@ -226,7 +226,7 @@ class CompareResult:
 
     def to_records(self) -> list[dict[str, Any]]:
         """The rows, JSON-ready (non-finite numbers as strings)."""
-        from .io import jsonable
+        from ..io import jsonable
         return jsonable([dict(r) for r in self.rows])
 
     def to_json(self) -> str:

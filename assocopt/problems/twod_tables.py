@@ -1,4 +1,4 @@
-"""Cached constant arrays and small helpers of the dense 2-D check (:mod:`assocopt.twod`):
+"""Cached constant arrays and small helpers of the dense 2-D check (:mod:`assocopt.problems.twod`):
 built once per size, shared read-only by every scan of that size."""
 
 from __future__ import annotations

@@ -1,4 +1,4 @@
-"""Checking user data before it becomes an :class:`~assocopt.problem.AssignmentProblem`.
+"""Checking user data before it becomes an :class:`~assocopt.problems.problem.AssignmentProblem`.
 
 Costs, axis sizes and candidate tuples arrive as lists, numpy arrays of any dtype or
 Python integers of any size.  Everything is checked in the input's own type before
@@ -16,7 +16,7 @@ from typing import Any, Sequence
 import numpy as np
 from numpy.typing import ArrayLike
 
-from .errors import InvalidProblemError, ProblemTooLargeError
+from ..runtime.errors import InvalidProblemError, ProblemTooLargeError
 
 __all__ = ["MAX_ABS_COST", "MAX_SIZE", "check_cost_dtype", "check_cost_range",
            "check_sizes", "check_tuples", "finite_floats", "require_memory"]

@@ -39,10 +39,10 @@ from typing import Any, Sequence
 
 import numpy as np
 
-from .api import solve
-from .errors import InvalidProblemError
-from .problem import AssignmentProblem
-from .solution import Status
+from ..solving.api import solve
+from ..runtime.errors import InvalidProblemError
+from ..problems.problem import AssignmentProblem
+from ..model.solution import Status
 
 __all__ = ["GENERATORS", "DEFAULT_SIZES", "generate", "generate_dense", "generate_sparse",
            "generate_planted", "prove_optimum", "feasibility", "catalogue", "write_index",
@@ -255,7 +255,7 @@ def feasibility(problem: AssignmentProblem, *, time_limit: float | None = 60.0
     dummy candidate for every real index; a full dense array), else by HiGHS within
     ``time_limit`` seconds (None: undecided when the limit is reached).
     """
-    from .problem import index_label
+    from ..problems.problem import index_label
 
     n_missing = problem.n_uncovered
     if n_missing:
@@ -281,7 +281,7 @@ def feasibility(problem: AssignmentProblem, *, time_limit: float | None = 60.0
 #: Copies of the stored instances shipped inside the package, so an installed
 #: assocopt has them without the source checkout (tests/test_instances_shipped.py
 #: checks that they equal ``instances/``).
-PACKAGED_INSTANCES = Path(__file__).resolve().parent / "data" / "instances"
+PACKAGED_INSTANCES = Path(__file__).resolve().parents[1] / "data" / "instances"
 
 
 def default_instances_dir() -> Path:
@@ -290,7 +290,7 @@ def default_instances_dir() -> Path:
     here = Path.cwd() / "instances"
     if here.is_dir():
         return here
-    project = Path(__file__).resolve().parent.parent / "instances"
+    project = Path(__file__).resolve().parents[2] / "instances"
     if (project / INDEX_NAME).is_file():
         return project
     return PACKAGED_INSTANCES
@@ -316,7 +316,7 @@ def catalogue(directory: str | os.PathLike[str]) -> list[dict[str, Any]]:
     ``sizes``, ``candidates``, ``optimum``, ``optimum_source``, ``description``.
     Files are read (and so validated) with :func:`assocopt.io.read_instance`.
     """
-    from .io import read_instance
+    from ..io import read_instance
 
     folder = Path(directory)
     if not folder.is_dir():

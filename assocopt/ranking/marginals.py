@@ -24,8 +24,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .errors import InvalidProblemError
-from .problem import AssignmentProblem
+from ..runtime.errors import InvalidProblemError
+from ..problems.problem import AssignmentProblem
 
 __all__ = ["marginals", "Marginals", "METHODS"]
 
@@ -84,8 +84,8 @@ def marginals(problem: AssignmentProblem, k: int = 100, temperature: float = 1.0
         sels = [s.selected for s in ranked]
         exhaustive = ranked.exhausted
     else:
-        from .errors import ProblemTooLargeError
-        from .solvers.bruteforce import enumerate_solutions
+        from ..runtime.errors import ProblemTooLargeError
+        from ..solvers.bruteforce import enumerate_solutions
 
         try:
             sels = list(enumerate_solutions(problem))

@@ -14,7 +14,7 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from .problem import AssignmentProblem
+from ..problems.problem import AssignmentProblem
 
 if TYPE_CHECKING:
     import scipy.sparse as sp
