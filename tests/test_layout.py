@@ -1,10 +1,12 @@
-"""The shape of the library: the core never imports tracking or paper code, modules stay
-small, and the project cites no file it does not ship.
+"""The shape of the library: layers import only downwards, no module imports itself
+through others, modules stay small, and the project cites no file it does not ship.
 
 Layers, lowest first: the core (everything under ``assocopt/`` not named below),
 ``assocopt.tracking`` (may import the core), ``assocopt.experiments`` (the core only),
-``assocopt.reproduce`` (anything).  Imports are read with :mod:`ast`, relative ones
-resolved, so the check covers ``from ..tracking import x`` as well.
+``assocopt.reproduce`` (anything).  Inside the core each package imports only the
+packages :data:`CORE` lists for it (its ``__init__`` says the same).  Imports are read
+with :mod:`ast`, relative ones resolved, so the check covers ``from ..tracking import
+x`` as well, and imports inside functions count like those at the top.
 """
 
 from __future__ import annotations
@@ -26,6 +28,26 @@ FORBIDDEN = {
     "core": UPPER,
     "assocopt.tracking": ("assocopt.experiments", "assocopt.reproduce"),
     "assocopt.experiments": ("assocopt.tracking", "assocopt.reproduce"),
+}
+#: The core's packages (and top-level modules), lowest first, each with the core
+#: packages it may import besides itself; each package's ``__init__`` docstring has a
+#: "May import:" line naming the same.  Every module may read ``assocopt._version``
+#: (a leaf); the package's own ``__init__`` / ``__main__`` (``"assocopt"``) may import
+#: all of them.
+_BASE = ("assocopt.runtime", "assocopt.problems", "assocopt.model", "assocopt.solvers")
+CORE: dict[str, tuple[str, ...]] = {
+    "assocopt.runtime": (),
+    "assocopt.problems": _BASE[:1],
+    "assocopt.model": _BASE[:2],
+    "assocopt.solvers": _BASE[:3],
+    "assocopt.solving": _BASE,
+    "assocopt.ranking": _BASE + ("assocopt.solving",),
+    "assocopt.io": _BASE,
+    "assocopt.workflow": _BASE + ("assocopt.solving", "assocopt.ranking", "assocopt.io"),
+    "assocopt.testing": _BASE + ("assocopt.solving", "assocopt.ranking", "assocopt.io",
+                                 "assocopt.workflow"),
+    "assocopt.cli": _BASE + ("assocopt.solving", "assocopt.ranking", "assocopt.io",
+                             "assocopt.workflow"),
 }
 #: The one place the core names the tracking layer: the cost builders of scenario
 #: models, looked up by name like a plug-in (assocopt/workflow/models.py, COST_LAYER).
@@ -54,14 +76,16 @@ def _layer(name: str) -> str:
     return "core"
 
 
-def _imports(name: str, path: Path) -> list[tuple[int, str]]:
-    """Every module ``name`` imports (absolute dotted names), with the line."""
+def _resolved(name: str, path: Path) -> list[tuple[int, str, tuple[str, ...]]]:
+    """Every import statement of module ``name`` anywhere in its file (top level, inside
+    functions, under ``TYPE_CHECKING``): ``(line, absolute module, names imported from
+    it)``; ``import a.b`` gives ``(line, "a.b", ())``."""
     tree = ast.parse(path.read_text(encoding="utf-8"))
     package = name if path.name == "__init__.py" else name.rpartition(".")[0]
     out = []
     for node in ast.walk(tree):
         if isinstance(node, ast.Import):
-            out += [(node.lineno, a.name) for a in node.names]
+            out += [(node.lineno, a.name, ()) for a in node.names]
         elif isinstance(node, ast.ImportFrom):
             if node.level:
                 base = package.split(".")
@@ -69,9 +93,82 @@ def _imports(name: str, path: Path) -> list[tuple[int, str]]:
                 mod = ".".join(base + ([node.module] if node.module else []))
             else:
                 mod = node.module or ""
-            out.append((node.lineno, mod))
-            out += [(node.lineno, f"{mod}.{a.name}") for a in node.names]  # from pkg import sub
+            out.append((node.lineno, mod, tuple(a.name for a in node.names)))
     return out
+
+
+def _imports(name: str, path: Path) -> list[tuple[int, str]]:
+    """Every module ``name`` imports (absolute dotted names), with the line."""
+    out = []
+    for line, mod, names in _resolved(name, path):
+        out.append((line, mod))
+        out += [(line, f"{mod}.{n}") for n in names]      # from pkg import sub
+    return out
+
+
+def _import_graph(modules: dict[str, Path]) -> dict[str, set[str]]:
+    """Module -> the project modules it imports.  ``from X import n`` counts ``X.n`` when
+    that is a module, else ``X``; ``import a.b`` counts ``a.b``.  Not counted: the
+    parent packages' ``__init__`` that Python runs before a submodule (a package that
+    re-exports its own modules would otherwise be a loop with each of them, and reading
+    a module never needs its package's ``__init__``)."""
+    graph: dict[str, set[str]] = {}
+    for name, path in modules.items():
+        out = set()
+        for _, mod, names in _resolved(name, path):
+            subs = {f"{mod}.{n}" for n in names} & modules.keys()
+            out |= subs
+            if len(subs) < len(names) or not names:
+                while mod and mod not in modules:
+                    mod = mod.rpartition(".")[0]
+                out |= {mod} if mod else set()
+        graph[name] = out - {name}
+    return graph
+
+
+def _cycles(graph: dict[str, set[str]]) -> list[list[str]]:
+    """The groups of modules that import each other in a loop (strongly connected
+    components of more than one module, Tarjan's algorithm), each sorted."""
+    index: dict[str, int] = {}
+    low: dict[str, int] = {}
+    stack: list[str] = []
+    on_stack: set[str] = set()
+    found = []
+
+    def visit(v: str) -> None:
+        index[v] = low[v] = len(index)
+        stack.append(v)
+        on_stack.add(v)
+        for w in sorted(graph[v]):
+            if w not in index:
+                visit(w)
+                low[v] = min(low[v], low[w])
+            elif w in on_stack:
+                low[v] = min(low[v], index[w])
+        if low[v] == index[v]:
+            group = []
+            while True:
+                w = stack.pop()
+                on_stack.discard(w)
+                group.append(w)
+                if w == v:
+                    break
+            if len(group) > 1:
+                found.append(sorted(group))
+
+    for v in sorted(graph):
+        if v not in index:
+            visit(v)
+    return sorted(found)
+
+
+def _part(name: str) -> str:
+    """The core package (or top-level module) ``name`` belongs to; ``"assocopt"`` for the
+    package's own ``__init__`` / ``__main__``."""
+    for part in tuple(CORE) + ("assocopt._version",):
+        if name == part or name.startswith(part + "."):
+            return part
+    return "assocopt"
 
 
 def _hits(mod: str, prefixes: tuple[str, ...]) -> bool:
@@ -100,6 +197,73 @@ def test_layers_import_only_downwards():
             if _hits(mod, forbidden):
                 bad.append(f"{path.relative_to(ROOT)}:{line} imports {mod}")
     assert not bad, "imports against the layering:\n" + "\n".join(bad)
+
+
+def test_core_packages_import_only_the_packages_below_them():
+    bad = []
+    for name, path in _modules().items():
+        part = _part(name)
+        if _layer(name) != "core" or part in ("assocopt", "assocopt._version"):
+            continue
+        allowed = (part, "assocopt._version") + CORE[part]
+        for line, mod in _imports(name, path):
+            if _hits(mod, ("assocopt",)) and not _hits(mod, UPPER) \
+                    and _part(mod) not in allowed:
+                bad.append(f"{path.relative_to(ROOT)}:{line} imports {mod} "
+                           f"({part} may import {', '.join(CORE[part]) or 'nothing'})")
+    assert not bad, "imports against the core's layering:\n" + "\n".join(bad)
+
+
+def test_each_core_package_says_what_it_may_import():
+    """The ``May import:`` line of each package's docstring names what :data:`CORE` does."""
+    for part, allowed in CORE.items():
+        init = ROOT / part.replace(".", "/") / "__init__.py"
+        if not init.is_file():           # a top-level module (assocopt.testing)
+            continue
+        doc = ast.get_docstring(ast.parse(init.read_text(encoding="utf-8"))) or ""
+        assert "May import:" in doc, f"{part}: its docstring does not say what it may import"
+        said = doc.split("May import:", 1)[1].split("\n\n", 1)[0]
+        named = set(re.findall(r"assocopt\.\w+", said))
+        assert named == set(allowed), (part, sorted(named), sorted(allowed))
+        if not allowed:
+            assert "nothing of assocopt" in said, part
+
+
+def test_no_import_cycles():
+    """No group of the project's modules imports each other in a loop, counting imports
+    inside functions too: each module can be read and changed with only what is below
+    it in mind."""
+    cycles = _cycles(_import_graph(_modules()))
+    graph = _import_graph(_modules())
+    report = ["  " + ", ".join(f"{m} -> {sorted(graph[m] & set(group))}" for m in group)
+              for group in cycles]
+    assert not cycles, "modules that import each other in a loop:\n" + "\n".join(report)
+
+
+def test_the_cycle_finder_finds_a_loop_through_a_function_level_import(tmp_path):
+    """The cycle check can fail: a loop closed by a lazy import inside a function, and
+    one through ``from package import module``, are both found; a package that imports
+    its own submodules is not a loop."""
+    pkg = tmp_path / "assocopt"
+    (pkg / "sub").mkdir(parents=True)
+    files = {"__init__.py": "from .sub import a\n",
+             "sub/__init__.py": "from .a import f\nfrom .b import g\n",
+             "sub/a.py": "from .b import g\ndef f():\n    return g()\n",
+             "sub/b.py": "def g():\n    from . import a\n    return a\n",
+             "c.py": "from .d import h\n", "d.py": "def h():\n    from .c import x\n",
+             "e.py": "from .sub.a import f\n"}
+    for rel, text in files.items():
+        (pkg / rel).write_text(text)
+    modules = {}
+    for p in pkg.rglob("*.py"):
+        parts = list(p.relative_to(tmp_path).with_suffix("").parts)
+        modules[".".join(parts[:-1] if parts[-1] == "__init__" else parts)] = p
+    graph = _import_graph(modules)
+    assert graph["assocopt.sub.b"] == {"assocopt.sub.a"}          # from . import a
+    assert _cycles(graph) == [["assocopt.c", "assocopt.d"], ["assocopt.sub.a", "assocopt.sub.b"]]
+    (pkg / "sub/b.py").write_text("def g():\n    return 1\n")
+    (pkg / "d.py").write_text("def h():\n    return 2\n")
+    assert _cycles(_import_graph(modules)) == []
 
 
 def test_the_core_names_upper_layers_only_at_declared_plugin_points():

@@ -21,6 +21,13 @@ Exit codes
 130  interrupted (Ctrl-C); 141: the output pipe was closed (e.g. ``| head``)
 
 Errors are one line on stderr, ``assocopt: error: <message>``, never a traceback.
+
+May import: :mod:`assocopt.runtime`, :mod:`assocopt.problems`, :mod:`assocopt.model`,
+:mod:`assocopt.solvers`, :mod:`assocopt.solving`, :mod:`assocopt.ranking`,
+:mod:`assocopt.io`, :mod:`assocopt.workflow`.
+
+``assocopt reproduce`` loads the paper reproductions by name, the one plug-in point
+into that layer.
 """
 # Package layout (split from the former single module ``cli.py``; names unchanged):
 #   common.py         exit codes, exit_code(), one-line errors, output formatting

@@ -53,6 +53,9 @@ so ``from assocopt.io import X`` works as before:
     Atomic writes: :func:`replace_atomically`, :func:`write_text_atomically`,
     :func:`write_json_atomically`, :func:`write_instance`, :func:`write_solution`,
     :func:`solution_to_dict`; the JSON sanitiser :func:`jsonable`.
+
+May import: :mod:`assocopt.runtime`, :mod:`assocopt.problems`, :mod:`assocopt.model`,
+:mod:`assocopt.solvers` (a model file is solved by a back end).
 """
 
 from __future__ import annotations

@@ -6,6 +6,8 @@ solve loads only the chosen back end.  Each module imports its optional package 
 inside ``solve``: a missing package costs nothing until that back end is asked for,
 and then fails with a message naming the package.  Submodules are also reachable as
 attributes (``assocopt.solvers.bnb``), imported on first access.
+
+May import: :mod:`assocopt.runtime`, :mod:`assocopt.problems`, :mod:`assocopt.model`.
 """
 
 from __future__ import annotations

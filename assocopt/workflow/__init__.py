@@ -4,6 +4,10 @@
 and its options), :mod:`.compare` runs back ends or models side by side,
 :mod:`.generate` makes instances with proven optima and lists the stored ones.
 
-May import: every other core package (:mod:`assocopt.io` included), never the CLI;
-the one plug-in point into :mod:`assocopt.tracking` is ``models.COST_LAYER``.
+May import: :mod:`assocopt.runtime`, :mod:`assocopt.problems`, :mod:`assocopt.model`,
+:mod:`assocopt.solvers`, :mod:`assocopt.solving`, :mod:`assocopt.ranking`,
+:mod:`assocopt.io`.
+
+Its one plug-in point into the tracking layer is ``models.COST_LAYER`` (the cost
+builders of scenario models, looked up by name).
 """
