@@ -217,17 +217,17 @@ def test_compare_keeps_going_when_a_back_end_raises(monkeypatch, capsys):
     assert code == EXIT_INTERNAL and "kaboom" in one_error_line(err)
 
 
-def test_compare_progress_counter_without_tqdm(monkeypatch):
+def test_compare_progress_bar_shows_each_run():
     from assocopt.runtime.progress import Progress
 
-    monkeypatch.setitem(sys.modules, "tqdm", None)           # as if tqdm were missing
     stream = io.StringIO()
     bar = Progress(2, True, "compare", unit="run", stream=stream)
     bar.update(1, "a highs")
     bar.update(1, "b highs")
     bar.close()
-    assert "compare: 1/2 runs" in stream.getvalue() and "a highs" in stream.getvalue()
-    assert "compare: 2/2 runs" in stream.getvalue() and "b highs" in stream.getvalue()
+    assert "compare:" in stream.getvalue() and "1/2" in stream.getvalue()
+    assert "a highs" in stream.getvalue()
+    assert "2/2" in stream.getvalue() and "b highs" in stream.getvalue()
     quiet = io.StringIO()
     off = Progress(2, False, "compare", stream=quiet)
     off.update(1, "x")

@@ -240,16 +240,7 @@ def test_failure_in_a_worker_does_not_wait_for_long_running_trials(tmp_path):
     assert time.monotonic() - t0 < 60
 
 
-def test_progress_counter_on_stderr(tmp_path, capsys, monkeypatch):
-    import builtins
-    real_import = builtins.__import__
-
-    def no_tqdm(name, *a, **k):
-        if name == "tqdm":
-            raise ImportError("no tqdm")
-        return real_import(name, *a, **k)
-
-    monkeypatch.setattr(builtins, "__import__", no_tqdm)
+def test_progress_bar_on_stderr(tmp_path, capsys):
     run_experiment(_exp(runs=2), tmp_path / "r.sqlite", progress=True)
     err = capsys.readouterr().err
-    assert "demo: 6/6 trials" in err
+    assert "demo:" in err and "6/6" in err and "trial" in err

@@ -53,7 +53,7 @@ def test_installed_copies_are_found_without_a_checkout(monkeypatch, tmp_path):
     from assocopt.testing import stored_instances
 
     monkeypatch.chdir(tmp_path)
-    fake_module = tmp_path / "site" / "assocopt" / "generate.py"
+    fake_module = tmp_path / "site" / "assocopt" / "workflow" / "generate.py"
     monkeypatch.setattr(gen, "__file__", str(fake_module))
     assert gen.default_instances_dir() == gen.PACKAGED_INSTANCES
     names = [p.name for p in stored_instances()]

@@ -31,8 +31,7 @@ works as ``executor`` -- a ``dask.distributed.Client`` does, so a cluster can ru
 the trials (dask is not a dependency).  The trial function must be picklable (a
 module-level function).
 
-Progress.  ``progress=True`` shows a tqdm bar when tqdm is installed, otherwise a
-counter on stderr.
+Progress.  ``progress=True`` shows a tqdm bar on stderr.
 
 One module per concept: :mod:`.design` (experiments, seeds), :mod:`.store`
 (the SQLite store), :mod:`.runner` (execution), :mod:`.summary` (means, paired

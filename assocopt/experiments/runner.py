@@ -76,7 +76,7 @@ def run_experiment(exp: Experiment, store: str | Path | ResultStore, *, workers:
         A ``concurrent.futures`` executor or a ``dask.distributed.Client``; used
         instead of the local pool (not shut down here).
     progress : bool
-        Show a progress bar (tqdm) or counter (stderr).
+        Show a progress bar (tqdm, on stderr).
     chunk_size : int, optional
         Trials per submitted task (default: chosen from the work left and workers).
 

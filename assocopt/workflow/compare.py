@@ -160,7 +160,7 @@ def compare(instances: Iterable[Any], *, solvers: Sequence[str] | None = None,
     repeat : int
         Solve each pair this many times and keep the fastest run (timings).
     progress : bool, optional
-        Progress bar on stderr (tqdm if installed); default: when stderr is a terminal.
+        Progress bar on stderr (tqdm); default: when stderr is a terminal.
     on_row : callable, optional
         Called with each row as soon as it is done.
     """
