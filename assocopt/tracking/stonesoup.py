@@ -180,7 +180,7 @@ class AssocoptKBest(AssocoptGNN):
 
     def associate_hypotheses(self, hypotheses) -> list:
         """The ``k`` best joint hypotheses of already generated ``hypotheses``."""
-        from ..ranking import kbest
+        from ..ranking.kbest import kbest
 
         if isinstance(self.k, bool) or int(self.k) != self.k or self.k < 1:
             raise ValueError(f"k must be a positive integer, got {self.k!r}")
