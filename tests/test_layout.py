@@ -290,11 +290,33 @@ def test_no_module_is_over_the_size_limit():
     assert not long, f"modules over {MAX_LINES} lines (split them by concept): {long}"
 
 
+#: What a newcomer looks for, and the file that holds it; the README's Layout section
+#: names each file and the folders on its way.
+CONCEPTS = {
+    "the S-D formulation": "model/formulation.py",
+    "the S-D problem": "problems/problem.py",
+    "the 2-D LAP": "solvers/lap.py",
+    "the HiGHS back end": "solvers/highs.py",
+    "solve": "solving/api.py",
+    "the KLD cost": "tracking/costs/kld.py",
+    "the dong2015 scenario": "tracking/scenarios/dong2015.py",
+    "the lu2013 scenario": "tracking/scenarios/lu2013.py",
+    "exact S-D solves by LP fixing": "solving/lp_fixing.py",
+    "model files": "io/mps_lp.py",
+    "localisation": "tracking/localisation/estimate.py",
+    "the experiments' store": "experiments/store.py",
+}
+
+
 def test_each_concept_is_found_by_file_name():
-    for rel in ("model/formulation.py", "solvers/highs.py", "tracking/costs/kld.py",
-                "tracking/scenarios/lu2013.py", "solving/lp_fixing.py", "io/mps_lp.py",
-                "tracking/localisation/estimate.py", "experiments/store.py",
-                "reproduce/lu2013/__init__.py", "reproduce/zhang2009/__init__.py"):
+    layout = (ROOT / "README.md").read_text(encoding="utf-8").split("## Layout", 1)[1]
+    layout = layout.split("\n## ", 1)[0]
+    for what, rel in CONCEPTS.items():
+        assert (PKG / rel).is_file(), rel
+        *folders, name = rel.split("/")
+        assert f"`{name}`" in layout and all(f"{d}/`" in layout for d in folders), \
+            f"README's Layout does not lead to {what} ({rel})"
+    for rel in ("reproduce/lu2013/__init__.py", "reproduce/zhang2009/__init__.py"):
         assert (PKG / rel).is_file(), rel
 
 
