@@ -181,7 +181,8 @@ def test_the_import_resolver_sees_relative_and_absolute_imports(tmp_path):
     pkg.mkdir(parents=True)
     f = pkg / "bad.py"
     f.write_text("from ..tracking.costs import COSTS\nimport assocopt.reproduce.lu2013\n"
-                 "from .. import experiments\ndef f():\n    from ..tracking.localisation import angles\n")
+                 "from .. import experiments\ndef f():\n"
+                 "    from ..tracking.localisation import angles\n")
     found = [m for _, m in _imports("assocopt.solvers.bad", f)]
     assert _hits(found[0], FORBIDDEN["core"])
     assert "assocopt.reproduce.lu2013" in found

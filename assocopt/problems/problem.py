@@ -181,7 +181,8 @@ class AssignmentProblem(IndexArithmetic):
 
     @property
     def dense_view(self) -> Any:
-        """The :class:`assocopt.problems.twod.Dense2D` of a problem built from a 2-D matrix, else None."""
+        """The :class:`~assocopt.problems.twod.Dense2D` of a problem built from a 2-D
+        matrix, else None."""
         return self._dense
 
     @classmethod

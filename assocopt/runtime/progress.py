@@ -22,7 +22,8 @@ class Progress:
 
     def __init__(self, total: int, enabled: bool, label: str, *, unit: str = "step",
                  initial: int = 0, stream: TextIO | None = None, leave: bool = True) -> None:
-        self.total, self.n, self.enabled, self.label, self.unit = total, initial, enabled, label, unit
+        self.total, self.n, self.enabled = total, initial, enabled
+        self.label, self.unit = label, unit
         self.bar = None
         if enabled:
             from tqdm import tqdm
