@@ -56,7 +56,7 @@ def _numba_installed() -> bool:
 def solve(problem: AssignmentProblem, solver: str = "auto", *, relax: str | None = None,
           time_limit: float | None = None, mip_gap: float = 0.0,
           threads: int | None = None, verbose: bool = False,
-          **options: Any) -> Solution:
+          decompose: bool | None = None, **options: Any) -> Solution:
     """Solve ``problem`` with the back end ``solver``.
 
     Parameters
@@ -74,6 +74,11 @@ def solve(problem: AssignmentProblem, solver: str = "auto", *, relax: str | None
         Relative gap at which MIP back ends may stop (default 0: proven optimum).
     threads : int, optional
         Threads for back ends that use them.
+    decompose : bool or None
+        Solve an S-D problem (N >= 3, integral, ``mip_gap`` 0) by its connected
+        components (:mod:`assocopt.decompose`): ``None`` (default) for problems of at
+        least :data:`assocopt.decompose.MIN_CANDIDATES` candidates, ``True`` always,
+        ``False`` never.  ``Solution.info["decomposition"]`` says how many there were.
     **options
         Back-end specific options, declared by each back end (``assocopt solvers
         --options NAME``, docs/solver-options.md); an unknown one is an error.  The
@@ -122,7 +127,13 @@ def solve(problem: AssignmentProblem, solver: str = "auto", *, relax: str | None
         raw = empty_answer(problem, opts)
     else:
         k0 = spent()
-        raw = solve_in_range(backend_cls(), problem, opts)
+        raw = None
+        if decompose is not False and _decomposable(problem, opts):
+            from .decompose import solve_decomposed
+            raw = solve_decomposed(problem, solver if not options else name, name, opts,
+                                   decompose)
+        if raw is None:
+            raw = solve_in_range(backend_cls(), problem, opts)
         k1 = spent()
         if k1 != k0:
             _kernel_times(raw, k0, k1)
@@ -130,6 +141,15 @@ def solve(problem: AssignmentProblem, solver: str = "auto", *, relax: str | None
     sol.info.setdefault("options", parsed)
     sol.times["total"] = time.perf_counter() - t0
     return sol
+
+
+def _decomposable(problem: AssignmentProblem, opts: SolveOptions) -> bool:
+    """Whether :mod:`assocopt.decompose` applies: an S-D ILP solved to optimality
+    (component gaps do not add up to a relative gap) with costs in range."""
+    if problem.ndim < 3 or opts.relax is not None or opts.mip_gap != 0.0:
+        return False
+    from .scaling import SCALE_ABOVE, max_abs_cost
+    return max_abs_cost(problem) <= SCALE_ABOVE
 
 
 _DIRECT = None
