@@ -61,17 +61,45 @@ def gated_tuples(sizes: Sequence[int], compatible: PairGate, pd: ArrayLike,
     if not may_miss[0]:
         partial = partial[1:]
     for s in range(1, N):
-        ok = np.ones((len(partial), sizes[s] + 1), dtype=bool)
+        k, j = _extensions(partial, s, sizes[s], pads)
+        keep = np.ones(len(k), dtype=bool)
         for t in range(s):
-            ok &= pads[(t, s)][partial[:, t]]
-        if not may_miss[s]:
-            ok[:, 0] = False
-        k, j = np.nonzero(ok)
+            keep &= pads[(t, s)][partial[k, t], j]
+        k, j = k[keep], j[keep]
+        if may_miss[s]:
+            k = np.concatenate([np.arange(len(partial)), k])
+            j = np.concatenate([np.zeros(len(partial), np.int64), j])
         partial = np.concatenate([partial[k], j[:, None]], axis=1)
     multi = partial[(partial > 0).sum(axis=1) >= 2]
     singles = _singletons(sizes, may_miss, cd)
     T = np.concatenate([multi, singles]).reshape(-1, N)
     return T[np.lexsort(T.T[::-1])]
+
+
+def _extensions(partial: np.ndarray, s: int, n_s: int, pads) -> tuple[np.ndarray, np.ndarray]:
+    """Pairs ``(k, j)``: partial tuple k and a real measurement j of sensor ``s``
+    compatible with k's first real measurement (every j for a partial tuple without
+    one); the caller checks the other members.  Only the gate's neighbours are
+    listed, never a (partial tuples x n_s) table."""
+    real = partial > 0
+    anchor = np.argmax(real, axis=1)
+    ks, js = [], []
+    empty = np.flatnonzero(~real.any(axis=1))
+    ks.append(np.repeat(empty, n_s))
+    js.append(np.tile(np.arange(1, n_s + 1, dtype=np.int64), len(empty)))
+    for t in range(s):
+        sel = np.flatnonzero(real[:, t] & (anchor == t))
+        if not len(sel):
+            continue
+        rows, cols = np.nonzero(pads[(t, s)][1:, 1:])        # CSR order: by row
+        ptr = np.zeros(pads[(t, s)].shape[0], np.int64)
+        np.cumsum(np.bincount(rows, minlength=len(ptr) - 1), out=ptr[1:])
+        r = partial[sel, t] - 1
+        cnt = ptr[r + 1] - ptr[r]
+        first = np.repeat(ptr[r] - (np.cumsum(cnt) - cnt), cnt)
+        ks.append(np.repeat(sel, cnt))
+        js.append(cols[first + np.arange(int(cnt.sum()))] + 1)
+    return np.concatenate(ks).astype(np.int64), np.concatenate(js).astype(np.int64)
 
 
 def _padded(sizes, compatible) -> dict[tuple[int, int], np.ndarray]:
