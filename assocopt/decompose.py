@@ -121,6 +121,14 @@ def local_tuples(problem: AssignmentProblem, part_of_row: np.ndarray, n_parts: i
     return T, counts.reshape(n_parts, N)
 
 
+def _full_grid(problem: AssignmentProblem) -> bool:
+    """Every real tuple is a candidate (a dense axial problem without forbidden
+    entries): one component, nothing to look for."""
+    import math
+    return problem.kind == "dense" and \
+        int((~problem.slack).sum()) == math.prod(problem.sizes)
+
+
 def _subproblem(problem: AssignmentProblem, T: np.ndarray, sizes: np.ndarray,
                 cand: np.ndarray) -> AssignmentProblem:
     """The problem of candidates ``cand`` (tuples already relabelled in ``T``)."""
@@ -171,11 +179,11 @@ def solve_decomposed(problem: AssignmentProblem, requested: str, name: str,
                      opts: SolveOptions, decompose: bool | None) -> RawResult | None:
     """Solve ``problem`` (every real index covered, ILP, costs in range) component by
     component, as the module docstring says (one component: by ``name`` whole); None
-    when ``decompose`` is None and the problem is below :data:`MIN_CANDIDATES`, for
-    the caller to solve whole.  ``requested``: the
+    when ``decompose`` is None and the problem is below :data:`MIN_CANDIDATES` or a
+    full grid of candidates, for the caller to solve whole.  ``requested``: the
     solver the user named (``"auto"`` only when no back-end option was given), ``name``
     the back end it stands for (whose options ``opts.extra`` holds)."""
-    if decompose is None and problem.n_candidates < MIN_CANDIDATES:
+    if decompose is None and (problem.n_candidates < MIN_CANDIDATES or _full_grid(problem)):
         return None
     t0 = time.perf_counter()
     sp = split(problem)

@@ -4,6 +4,8 @@
     python benchmarks/sd_tracking.py            # the run: docs/benchmarks-tracking.json, .md
     python benchmarks/sd_tracking.py --quick    # smoke run (small scans only)
     python benchmarks/sd_tracking.py --render   # the page from the committed JSON
+    python benchmarks/sd_tracking.py --profile  # where auto's time goes (cProfile),
+                                                # whole (decompose=False) and decomposed
 
 Scans come from ``benchmarks/tracking_scans.py`` (N position sensors in the plane,
 P_D 0.9, clutter as a share of the targets, tuples gated pairwise at 99.9 %, negative
@@ -127,6 +129,28 @@ def warm_up() -> None:
         solve(q, "lagrangian-exact")
 
 
+def profile(top: int = 14) -> None:
+    """cProfile of ``solve(p)`` on N = 3, n = 1000 and N = 6, n = 100 (spacing 2,
+    clutter 0.2, seed 1), whole (``decompose=False``: auto before decomposition) and
+    decomposed, top functions by cumulative time."""
+    import cProfile
+    import pstats
+    warm_up()
+    for N, n in ((3, 1000), (6, 100)):
+        p, _ = build_problem(ScanSpec(N, n, spacing=2.0, clutter=0.2, seed=1))
+        for kw in ({"decompose": False}, {}):
+            solve(p, **kw)
+            pr = cProfile.Profile()
+            t0 = time.perf_counter()
+            pr.enable()
+            sol = solve(p, **kw)
+            pr.disable()
+            print(f"\n=== N={N} n={n} K={p.n_candidates} {kw or 'decomposed'}: "
+                  f"{time.perf_counter() - t0:.3f} s, {sol.solver}, {sol.status.value}, "
+                  f"{sol.info.get('decomposition')}", flush=True)
+            pstats.Stats(pr).sort_stats("cumulative").print_stats(top)
+
+
 def environment(argv) -> dict:
     env = _environment(argv)
     env["command"] = env["command"].replace("sd_scaling.py", "sd_tracking.py")
@@ -137,6 +161,7 @@ def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     ap.add_argument("--quick", action="store_true", help="small scans only (smoke run)")
     ap.add_argument("--render", action="store_true", help="the page from the JSON only")
+    ap.add_argument("--profile", action="store_true", help="cProfile auto, print, exit")
     ap.add_argument("--out", default=str(ROOT / "docs" / "benchmarks-tracking.md"))
     ap.add_argument("--time-limit", type=float, default=60.0,
                     help="per solve of the plain milp model (s)")
@@ -149,6 +174,9 @@ def main(argv=None) -> int:
     page = Path(args.out)
     json_path = page.with_suffix(".json")
     page.parent.mkdir(parents=True, exist_ok=True)
+    if args.profile:
+        profile()
+        return 0
     if args.render:
         write_text_atomically(page, tracking_page.render(json.loads(json_path.read_text())))
         return 0

@@ -5,8 +5,9 @@ Used by :mod:`assocopt.decompose`: the components ``bnb`` suits are concatenated
 :func:`assocopt.solvers.kernels.batch.solve_batch`, which runs ``bnb``'s ascent and
 search on each in turn, at ``bnb``'s default settings (or those given with
 ``solver="bnb"``).  Components whose node budget runs out are returned to the
-caller, which solves them alone (``lagrangian-exact``); a time limit stops the call
-between two ascent iterations or 1024 search nodes.
+caller, which solves them alone (``lagrangian-exact``); a time limit or Ctrl-C stops
+the call between two ascent iterations or 1024 search nodes (a batch of more than
+``bnb.INLINE_CANDIDATES`` candidates runs in a worker thread, as ``bnb`` does).
 """
 
 from __future__ import annotations
@@ -17,7 +18,7 @@ import numpy as np
 
 from ..solution import Status
 from .base import SolveOptions
-from .bnb import DEFAULTS, TOL
+from .bnb import DEFAULTS, INLINE_CANDIDATES, TOL
 from .interruptible import new_stop, run_stoppable
 
 __all__ = ["solve_components", "batch_arrays", "run_batch"]
@@ -48,7 +49,7 @@ def run_batch(T: np.ndarray, c: np.ndarray, kp: np.ndarray, sizes: np.ndarray,
             p["stall_tol"], new_stop())
     ensure(solve_batch, *args)
     return run_stoppable(solve_batch, args, args[-1], deadline=deadline,
-                         inline=deadline is None)
+                         inline=len(T) <= INLINE_CANDIDATES)
 
 
 def solve_components(problem: Any, T: np.ndarray, csizes: np.ndarray, sp: Any,
