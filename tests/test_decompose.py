@@ -181,3 +181,25 @@ def test_batch_kernel_equals_brute_force(parts):
         p = AssignmentProblem.sparse(sizes, T, c)
         assert p.violations(sel) is None
         assert lb[i] <= ub[i] + 1e-9
+
+
+def test_time_limit_is_shared_and_a_stopped_component_stops_the_whole():
+    T = np.array([[i, j, k] for i in range(3) for j in range(3) for k in range(3)
+                  if (i, j, k) != (0, 0, 0)])
+    T2 = np.concatenate([T, np.where(T > 0, T + 2, 0)])
+    c = np.random.default_rng(3).normal(size=len(T2))
+    p = AssignmentProblem.sparse((4, 4, 4), T2, c)
+    sol = solve(p, "highs", decompose=True, time_limit=1e-9)
+    assert sol.status is Status.TIME_LIMIT and sol.selected is None
+    assert sol.info["decomposition"]["components"] == 2
+
+
+def test_maximize_decomposed():
+    T = np.array([[1, 1, 0], [1, 0, 0], [0, 1, 0], [2, 0, 2], [2, 0, 0], [0, 0, 2],
+                  [0, 0, 1], [0, 2, 0]])
+    p = AssignmentProblem.sparse((2, 2, 2), T, [3.0, 1.0, 1.0, -1.0, 0.5, 0.25, 0.0, 0.0],
+                                 maximize=True)
+    for solver in ("highs", "auto"):
+        a = solve(p, solver, decompose=True)
+        b = solve(p, "bruteforce", decompose=False)
+        assert a.objective == b.objective == 3.75 and a.bound == 3.75
