@@ -234,23 +234,28 @@ def _solve_parts(problem: AssignmentProblem, sp: Split, todo: np.ndarray,
     T, csizes = local_tuples(problem, sp.of_row, sp.n)
     plain_auto = requested == "auto"
     single, grouped, n_batched = todo, todo[:0], 0
+    spent = np.zeros(sp.n, bool)              # node budget spent in the batch
     if (plain_auto or name == "bnb") and _numba_installed():
-        top2 = np.sort(csizes[todo], axis=1)[:, -2:].sum(axis=1)
-        fits = (sp.sizes[todo] <= BNB_MAX_CANDIDATES) & (top2 <= BNB_MAX_KEPT)
-        if name == "bnb":
-            fits[:] = True        # bnb asked for: its own fallback decides
+        top2 = np.sort(csizes[todo], axis=1)[:, -2:]
+        if name == "bnb":         # bnb asked for: all that its kernels take
+            from .solvers.bnb import MAX_DENSE, MAX_KEPT
+            fits = (top2.sum(axis=1) <= MAX_KEPT) & \
+                ((top2[:, 0] + 1) * (top2[:, 1] + 1) <= MAX_DENSE)
+        else:
+            fits = (sp.sizes[todo] <= BNB_MAX_CANDIDATES) & (top2.sum(axis=1) <= BNB_MAX_KEPT)
         from .solvers.bnb_batch import solve_components
         left = _left(opts, t0)()
         redo = solve_components(problem, T, csizes, sp, todo[fits], opts, left, out)
         n_batched = int(fits.sum()) - len(redo)
+        spent[redo] = True
         single = np.concatenate([redo, todo[~fits]]).astype(np.int64)
     elif name in GROUPED:
         small = sp.sizes[todo] <= GROUP_MAX
         single, grouped = todo[~small], todo[small]
-    jobs = [(csizes[c], sp.order[sp.ptr[c]:sp.ptr[c + 1]], 1) for c in single]
+    jobs = [(csizes[c], sp.order[sp.ptr[c]:sp.ptr[c + 1]], 1, spent[c]) for c in single]
     if len(grouped):
-        jobs.append(_group(T, csizes, sp, grouped))
-    for sizes, cand, count in jobs:
+        jobs.append(_group(T, csizes, sp, grouped) + (False,))
+    for sizes, cand, count, again in jobs:
         remaining = _left(opts, t0)()
         if remaining is not None and remaining <= 0:
             out.add(Status.TIME_LIMIT, None, None, name, count,
@@ -258,6 +263,8 @@ def _solve_parts(problem: AssignmentProblem, sp: Split, todo: np.ndarray,
             continue
         sub = _subproblem(problem, T, sizes, cand)
         solver = _auto_choice(sub) if plain_auto else name
+        if plain_auto and again:              # bnb's node budget ran out on it
+            solver = "lagrangian-exact"
         o = _auto_options(sub, solver, _defaults(opts)) if plain_auto else opts
         out.add_raw(_solve_one(sub, solver, o, remaining), cand, solver, count)
     return n_batched

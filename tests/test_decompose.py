@@ -203,3 +203,17 @@ def test_maximize_decomposed():
         a = solve(p, solver, decompose=True)
         b = solve(p, "bruteforce", decompose=False)
         assert a.objective == b.objective == 3.75 and a.bound == 3.75
+
+
+@settings(max_examples=30)
+@given(side_by_side())
+def test_batch_budget_spent_components_are_solved_again(p):
+    """bnb's batch with a node budget of 1: the components it cannot prove go to
+    bnb alone (and its fallback), and the whole is still exact."""
+    pytest.importorskip("numba")
+    whole = solve(p, "bruteforce", decompose=False)
+    sol = solve(p, "bnb", decompose=True, max_nodes=1, max_iter=1, probe_every=0,
+                recover_every=0)
+    _agree(sol, whole)
+    if sol.status is Status.OPTIMAL:
+        assert_optimal(p, sol)
