@@ -39,8 +39,9 @@ from .solvers.base import RawResult, SolveOptions, get_backend
 __all__ = ["Split", "split", "solve_decomposed", "MIN_CANDIDATES", "GROUP_MAX"]
 
 #: ``decompose=None`` (the default) looks for components in problems with at least
-#: this many candidates; below it the search for components costs more (about 0.1 ms)
-#: than it can save.
+#: this many candidates: the search costs about 0.1-0.2 ms (measured on a 280-candidate
+#: scan, 2 loaded cores), against 0.5 ms for ``bnb`` on all of it, so smaller problems
+#: are solved whole.
 MIN_CANDIDATES = 200
 #: MILP / CP back ends solve components of at most this many candidates together, as
 #: one problem (one model, one call), and larger ones one by one.
@@ -91,7 +92,11 @@ def split(problem: AssignmentProblem) -> Split:
     real = R >= 0
     first = R[np.arange(K), np.argmax(real, axis=1)]
     src = np.broadcast_to(first[:, None], R.shape)[real]
-    graph = csr_matrix((np.ones(len(src), np.int8), (src, R[real])), shape=(E, E))
+    dst = R[real][np.argsort(src, kind="stable")]
+    ptr = np.zeros(E + 1, np.int64)                # CSR built directly (no COO pass)
+    np.cumsum(np.bincount(src, minlength=E), out=ptr[1:])
+    idx = np.int32 if E < 2 ** 31 else np.int64
+    graph = csr_matrix((np.ones(len(dst)), dst.astype(idx), ptr.astype(idx)), shape=(E, E))
     n, of_row = connected_components(graph, directed=False)
     of_row = of_row.astype(np.int64)
     of_cand = of_row[first]
