@@ -123,10 +123,12 @@ def warm_up() -> None:
     p, _ = build_problem(spec)
     for m in METHODS:
         run_one(m, p.sizes, np.array(p.tuples), np.array(p.costs), 10.0)
+    from assocopt.decompose import TRACKING_OPTIONS
     for N in (3, 4, 5, 6):                     # every kernel specialisation the run uses
         q, _ = build_problem(ScanSpec(N, 20, spacing=1.0, seed=98))
         solve(q)
         solve(q, "lagrangian-exact")
+        solve(q, "lagrangian-exact", **TRACKING_OPTIONS)
 
 
 def profile(top: int = 14) -> None:
