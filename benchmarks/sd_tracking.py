@@ -47,12 +47,17 @@ from assocopt.io import write_text_atomically  # noqa: E402
 
 METHODS = ("auto", "highs", "highs-whole", "scipy", "milp")
 
-#: (N, n, spacing in gate radii, clutter share): the scans of the run; seeds 1, 2
+#: (N, n, spacing in gate radii, clutter share): the scans of the run (P_D 0.9);
+#: seeds 1, 2
 SCANS = [(3, 200, 2.0, 0.2), (3, 1000, 2.0, 0.2), (3, 1000, 2.0, 0.5), (3, 500, 2.0, 0.0),
          (4, 100, 2.0, 0.2), (4, 300, 2.0, 0.2), (5, 50, 2.0, 0.2), (5, 200, 2.0, 0.2),
          (6, 100, 2.0, 0.2), (3, 200, 4.0, 0.2), (3, 300, 0.7, 0.2), (4, 100, 1.0, 0.2),
          (5, 100, 1.0, 0.2)]
 QUICK = [(3, 100, 2.0, 0.2), (4, 50, 2.0, 0.2), (5, 30, 2.0, 0.2), (3, 60, 0.7, 0.2)]
+#: Scans not used while tuning (other P_D, spacings, clutter; seeds 31 on): the
+#: targets are checked on them too.  (N, n, spacing, clutter, pd)
+UNSEEN = [(3, 400, 1.5, 0.3, 0.8), (4, 200, 2.5, 0.1, 0.95), (6, 60, 2.0, 0.4, 0.9),
+          (3, 150, 0.5, 0.2, 0.9), (5, 120, 1.5, 0.2, 0.9)]
 
 
 def plain_milp(sizes, T: np.ndarray, c: np.ndarray, time_limit: float):
@@ -192,9 +197,11 @@ def main(argv=None) -> int:
 
     warm_up()
     rows = []
-    for N, n, spacing, clutter in (QUICK if args.quick else SCANS):
-        for seed in range(1, args.seeds + 1):
-            spec = ScanSpec(N, n, spacing=spacing, clutter=clutter, seed=seed)
+    plan = [(s + (0.9,), 1) for s in (QUICK if args.quick else SCANS)]
+    plan += [] if args.quick else [(s, 31) for s in UNSEEN]
+    for (N, n, spacing, clutter, pd), first in plan:
+        for seed in range(first, first + args.seeds):
+            spec = ScanSpec(N, n, spacing=spacing, clutter=clutter, pd=pd, seed=seed)
             K_est = rows[-1]["K"] if rows and rows[-1]["spec"]["N"] == N and \
                 rows[-1]["spec"]["n"] == n and rows[-1]["spec"]["spacing"] == spacing else 0
             skip = {m: f"K > {args.milp_max}" for m in ("milp", "scipy")

@@ -16,7 +16,7 @@ NAMES = {"auto": "`auto`", "highs": "`highs`", "highs-whole": "`highs`, whole",
 
 def setting(row: dict) -> tuple:
     s = row["spec"]
-    return s["N"], s["n"], s["spacing"], s["clutter"]
+    return s["N"], s["n"], s["spacing"], s["clutter"], s["pd"]
 
 
 def groups(data: dict) -> dict[tuple, list[dict]]:
@@ -52,11 +52,11 @@ def _load(v) -> str:
 
 def summary_table(data: dict) -> list[str]:
     methods = data["options"]["methods"]
-    P = ["| N | n | spacing | clutter | scans | K (mean) | components (largest K) | "
+    P = ["| N | n | spacing | clutter | P_D | scans | K (mean) | components (largest K) | "
          "gate s | tuples s | " + " | ".join(f"{NAMES[m]} s" for m in methods) +
          " | `highs` / `auto` | plain milp / `auto` |",
-         "|" + "---|" * (11 + len(methods))]
-    for (N, n, sp, cl), rows in groups(data).items():
+         "|" + "---|" * (12 + len(methods))]
+    for (N, n, sp, cl, pd), rows in groups(data).items():
         K = sum(r["K"] for r in rows) / len(rows)
         comps = "; ".join(f"{r['results']['auto']['info'].get('components', 1)} "
                           f"({r['results']['auto']['info'].get('largest', r['K'])})"
@@ -67,7 +67,7 @@ def summary_table(data: dict) -> list[str]:
             cells.append("-" if t is None else
                          f"{t:.3f} ({proven(rows, m)}/{len(rows)})")
         t_a = total(rows, "auto")
-        P.append(f"| {N} | {n} | {sp:g} | {cl:g} | {len(rows)} | {K:.0f} | {comps} | "
+        P.append(f"| {N} | {n} | {sp:g} | {cl:g} | {pd:g} | {len(rows)} | {K:.0f} | {comps} | "
                  f"{sum(r['build'].get('gate_s', 0.0) for r in rows):.3f} | "
                  f"{sum(r['build']['tuples_s'] for r in rows):.3f} | " + " | ".join(cells) +
                  f" | {_x(ratio(total(rows, 'highs'), t_a))} | "
@@ -92,19 +92,20 @@ def targets(data: dict) -> list[str]:
                f"N={r['spec']['N']} n={r['spec']['n']} seed {r['spec']['seed']}"
                for r in slower) + ")") + "."]
 
-    def worst(keys, what) -> str:
-        rs = [ratio(total(g[k], "highs"), total(g[k], "auto")) for k in keys]
-        rs = [v for v in rs if v is not None]
-        return f"{what}: `highs` / `auto` at least {min(rs):.1f}x" if rs else \
-            f"{what}: no scan"
+    def worst(keys, what, num="highs") -> str:
+        rs = [(ratio(total(g[k], num), total(g[k], "auto")), k) for k in keys]
+        rs = [(v, k) for v, k in rs if v is not None]
+        if not rs:
+            return f"{what}: no scan"
+        v, k = min(rs)
+        met = sum(r >= target(what) for r, _ in rs)
+        return (f"{what}: {NAMES[num]} / `auto` at least {v:.1f}x (N={k[0]} n={k[1]} "
+                f"spacing {k[2]:g}); met on {met} of {len(rs)} settings")
     sparse = [k for k in g if k[2] > DENSE]
     out.append("- " + worst([k for k in sparse if k[0] == 3 and k[1] >= 200],
                             "N = 3, n >= 200 (target 5x)"))
     out.append("- " + worst([k for k in sparse if k[0] >= 4], "N >= 4 (target 10x)"))
-    m5 = [ratio(total(g[k], "milp"), total(g[k], "auto")) for k in g if k[0] >= 5]
-    m5 = [v for v in m5 if v is not None]
-    out.append("- N >= 5: plain milp / `auto` at least "
-               f"{min(m5):.1f}x (target 50x)" if m5 else "- N >= 5: plain milp not run")
+    out.append("- " + worst([k for k in g if k[0] >= 5], "N >= 5 (target 50x)", "milp"))
     out.append("- " + worst([k for k in g if k[2] <= DENSE],
                             "one dense component, spacing at or below the gate "
                             "(target 3x)"))
@@ -117,11 +118,16 @@ def targets(data: dict) -> list[str]:
     return out
 
 
+def target(what: str) -> float:
+    """The ratio a target line asks for (read from its ``(target Nx)``)."""
+    return float(what.split("(target ")[1].split("x")[0])
+
+
 def readme_figures(data: dict) -> list[str]:
     """The phrases README.md's Speed section quotes, as rounded here."""
     g = groups(data)
     out = []
-    for key in ((3, 1000, 2.0, 0.2), (6, 100, 2.0, 0.2)):
+    for key in ((3, 1000, 2.0, 0.2, 0.9), (6, 100, 2.0, 0.2, 0.9)):
         if key in g:
             rows = g[key]
             t_a, t_h, t_m = (total(rows, m) for m in ("auto", "highs", "milp"))
@@ -148,7 +154,8 @@ def render(data: dict) -> str:
          "Scans of `benchmarks/tracking_scans.py`: N position sensors in the plane, n "
          "targets in a square whose side makes the mean target spacing `spacing` gate "
          "radii (4: well separated; below 1: closer than the gate, one dense component), "
-         "P_D 0.9, `clutter * n` false alarms per sensor, tuples gated pairwise at 99.9 % "
+         "P_D 0.9 (0.8 to 0.95 in the unseen settings), `clutter * n` false alarms per "
+         "sensor, tuples gated pairwise at 99.9 % "
          "(chi-square, 2 dof) and enumerated by `assocopt.tracking.sd_gating.gated_tuples`, "
          "negative log-likelihood-ratio costs.  Each method is timed from the candidate "
          "arrays on: `solve(AssignmentProblem.sparse(sizes, T, c), solver)`; "
@@ -160,6 +167,7 @@ def render(data: dict) -> str:
          f"milp with a limit of {opt['time_limit']:g} s; plain milp and `scipy` "
          f"are left out of scans with more than {opt['milp_max']} candidates.  Times are "
          "summed over the scans of a setting; `(p/k)`: proven optimal in p of k.  "
+         "The settings with seeds from 31 on (the last ones) were not used while tuning.  "
          "`components (largest K)`: how `auto` split each scan; `gate s`: the pairwise "
          "gate (KD-trees), `tuples s`: `gated_tuples` (both summed over the scans).  "
          f"The targets count scans with spacing above {DENSE:g} as sparse, the others as "

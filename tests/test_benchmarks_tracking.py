@@ -67,10 +67,11 @@ def test_totals_and_ratios_are_those_of_the_scan_times():
     g = mod.groups(data)
     assert len(rows) == len(g)
     for cells, (key, scans) in zip(rows, g.items()):
-        assert (int(cells[0]), int(cells[1]), float(cells[2]), float(cells[3])) == key
-        assert int(cells[4]) == len(scans)
+        assert (int(cells[0]), int(cells[1]), float(cells[2]), float(cells[3]),
+                float(cells[4])) == key
+        assert int(cells[5]) == len(scans)
         times = {}
-        for m, cell in zip(methods, cells[9:9 + len(methods)]):
+        for m, cell in zip(methods, cells[10:10 + len(methods)]):
             if cell == "-":
                 assert any(m not in s["results"] for s in scans)
                 continue
