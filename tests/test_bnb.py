@@ -146,7 +146,7 @@ def test_auto_picks_bnb_for_small_sd():
 
 
 def test_auto_without_numba_uses_lagrangian_exact(monkeypatch):
-    import assocopt.solving.api as api
+    import assocopt.solving.choice as api
     monkeypatch.setattr(api, "_numba_installed", lambda: False)
     assert choose_solver(AssignmentProblem.dense(np.ones((3, 3, 3)))) == "lagrangian-exact"
 

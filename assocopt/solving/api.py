@@ -14,49 +14,15 @@ from ..solvers.base import (Backend, RawResult, SolveOptions, check_capabilities
                             empty_answer, get_backend, module_installed)
 from ..solvers.kernels import spent
 from ..solvers.scaling import solve_in_range
+from .choice import BNB_MAX_CANDIDATES, choose_solver
 
 __all__ = ["solve", "choose_solver", "BNB_MAX_CANDIDATES"]
-
-
-#: ``auto`` sends N >= 3 problems with at most this many candidates to ``bnb``
-#: (compiled branch and bound) when numba is installed; measured faster than
-#: ``lagrangian-exact`` up to Grundel n = 20 (8,000 candidates), slower at n = 30
-#: (docs/benchmarks-sd.md).
-BNB_MAX_CANDIDATES = 10_000
-#: ... and with at most this many real indices on the two kept axes: ``bnb``'s dense
-#: Hungarian costs O((n_a + n_b)^3) per iteration, ``lagrangian-exact``'s sparse LAP
-#: far less on large sparse problems.
-BNB_MAX_KEPT = 100
-
-
-def choose_solver(problem: AssignmentProblem, relax: str | None = None) -> str:
-    """The back end ``solver="auto"`` picks, by size and structure (measured in
-    docs/benchmarks-sd.md): the 2-D fast path; for S-D (N >= 3) the compiled branch
-    and bound ``bnb`` up to :data:`BNB_MAX_CANDIDATES` candidates and
-    :data:`BNB_MAX_KEPT` kept-axes indices (numba installed), else the Lagrangian exact
-    method; HiGHS for LP relaxations."""
-    if relax is not None:
-        return "highs"
-    if problem.ndim == 2:
-        return "scipy-lsa"
-    if problem.n_candidates <= BNB_MAX_CANDIDATES and _bnb_usable(problem):
-        return "bnb"
-    return "lagrangian-exact"
-
-
-def _bnb_usable(problem: AssignmentProblem) -> bool:
-    from ..solvers.bnb import kept_sizes
-    return _numba_installed() and sum(kept_sizes(problem)) <= BNB_MAX_KEPT
-
-
-def _numba_installed() -> bool:
-    return module_installed("numba")
 
 
 def solve(problem: AssignmentProblem, solver: str = "auto", *, relax: str | None = None,
           time_limit: float | None = None, mip_gap: float = 0.0,
           threads: int | None = None, verbose: bool = False,
-          **options: Any) -> Solution:
+          decompose: bool | None = None, **options: Any) -> Solution:
     """Solve ``problem`` with the back end ``solver``.
 
     Parameters
@@ -74,6 +40,11 @@ def solve(problem: AssignmentProblem, solver: str = "auto", *, relax: str | None
         Relative gap at which MIP back ends may stop (default 0: proven optimum).
     threads : int, optional
         Threads for back ends that use them.
+    decompose : bool or None
+        Solve an S-D problem (N >= 3, integral, ``mip_gap`` 0) by its connected
+        components (:mod:`assocopt.solving.decompose`): ``None`` (default) for problems of at
+        least :data:`assocopt.solving.decompose.MIN_CANDIDATES` candidates, ``True`` always,
+        ``False`` never.  ``Solution.info["decomposition"]`` says how many there were.
     **options
         Back-end specific options, declared by each back end (``assocopt solvers
         --options NAME``, docs/solver-options.md); an unknown one is an error.  The
@@ -122,7 +93,13 @@ def solve(problem: AssignmentProblem, solver: str = "auto", *, relax: str | None
         raw = empty_answer(problem, opts)
     else:
         k0 = spent()
-        raw = solve_in_range(backend_cls(), problem, opts)
+        raw = None
+        if decompose is not False and _decomposable(problem, opts):
+            from .decompose import solve_decomposed
+            raw = solve_decomposed(problem, solver if not options else name, name, opts,
+                                   decompose)
+        if raw is None:
+            raw = solve_in_range(backend_cls(), problem, opts)
         k1 = spent()
         if k1 != k0:
             _kernel_times(raw, k0, k1)
@@ -130,6 +107,15 @@ def solve(problem: AssignmentProblem, solver: str = "auto", *, relax: str | None
     sol.info.setdefault("options", parsed)
     sol.times["total"] = time.perf_counter() - t0
     return sol
+
+
+def _decomposable(problem: AssignmentProblem, opts: SolveOptions) -> bool:
+    """Whether :mod:`assocopt.solving.decompose` applies: an S-D ILP solved to optimality
+    (component gaps do not add up to a relative gap) with costs in range."""
+    if problem.ndim < 3 or opts.relax is not None or opts.mip_gap != 0.0:
+        return False
+    from ..solvers.scaling import SCALE_ABOVE, max_abs_cost
+    return max_abs_cost(problem) <= SCALE_ABOVE
 
 
 _DIRECT = None

@@ -54,19 +54,24 @@ def gated_tuples(sizes: Sequence[int], compatible: PairGate, pd: ArrayLike,
     pd_a = np.broadcast_to(np.asarray(pd, float), (N,))
     cd = np.zeros(N) if clutter_density is None else \
         np.broadcast_to(np.asarray(clutter_density, float), (N,))
-    pads = _padded(sizes, compatible)
+    pairs = _pairs(sizes, compatible)
     may_miss = pd_a < 1.0
     # multi-measurement tuples: a dummy only where the sensor may miss
     partial = np.arange(sizes[0] + 1, dtype=np.int64)[:, None]
     if not may_miss[0]:
         partial = partial[1:]
     for s in range(1, N):
-        ok = np.ones((len(partial), sizes[s] + 1), dtype=bool)
+        k, j = _extensions(partial, s, sizes[s], pairs)
+        keep = np.ones(len(k), dtype=bool)
         for t in range(s):
-            ok &= pads[(t, s)][partial[:, t]]
-        if not may_miss[s]:
-            ok[:, 0] = False
-        k, j = np.nonzero(ok)
+            if pairs[(t, s)] is not None:      # a dummy in t is compatible with all
+                i = partial[k, t]
+                m = np.flatnonzero(i > 0)
+                keep[m] &= pairs[(t, s)][0][i[m] - 1, j[m] - 1]
+        k, j = k[keep], j[keep]
+        if may_miss[s]:
+            k = np.concatenate([np.arange(len(partial)), k])
+            j = np.concatenate([np.zeros(len(partial), np.int64), j])
         partial = np.concatenate([partial[k], j[:, None]], axis=1)
     multi = partial[(partial > 0).sum(axis=1) >= 2]
     singles = _singletons(sizes, may_miss, cd)
@@ -74,25 +79,61 @@ def gated_tuples(sizes: Sequence[int], compatible: PairGate, pd: ArrayLike,
     return T[np.lexsort(T.T[::-1])]
 
 
-def _padded(sizes, compatible) -> dict[tuple[int, int], np.ndarray]:
-    """Compatibility matrices with a dummy row and column (always compatible)."""
+def _extensions(partial: np.ndarray, s: int, n_s: int, pairs) -> tuple[np.ndarray, np.ndarray]:
+    """Pairs ``(k, j)``: partial tuple k and a real measurement j of sensor ``s``
+    compatible with k's first real measurement (every j for a partial tuple without
+    one, or whose first sensor's pair with ``s`` is not gated); the caller checks the
+    other members.  Only the gate's neighbours are listed (CSR lists of each
+    measurement's compatible ones), never a (partial tuples x n_s) table."""
+    real = partial > 0
+    anchor = np.where(real.any(axis=1), np.argmax(real, axis=1), -1)
+    ks, js = [], []
+    every = anchor < 0
+    for t in range(s):
+        if pairs[(t, s)] is None:
+            every |= anchor == t
+    full = np.flatnonzero(every)
+    ks.append(np.repeat(full, n_s))
+    js.append(np.tile(np.arange(1, n_s + 1, dtype=np.int64), len(full)))
+    for t in range(s):
+        sel = np.flatnonzero(anchor == t)
+        if pairs[(t, s)] is None or not len(sel):
+            continue
+        _, ptr, cols = pairs[(t, s)]
+        r = partial[sel, t] - 1
+        cnt = ptr[r + 1] - ptr[r]
+        first = np.repeat(ptr[r] - (np.cumsum(cnt) - cnt), cnt)
+        ks.append(np.repeat(sel, cnt))
+        js.append(cols[first + np.arange(int(cnt.sum()))] + 1)
+    return np.concatenate(ks).astype(np.int64), np.concatenate(js).astype(np.int64)
+
+
+def _pairs(sizes, compatible) -> dict:
+    """For every sensor pair ``(s, t)``: None (not gated: all compatible), or the
+    boolean matrix with its CSR lists ``(M, ptr, cols)`` (0-based, real indices)."""
     N = len(sizes)
-    out = {}
-    for s in range(N):
-        for t in range(s + 1, N):
-            M = np.ones((sizes[s] + 1, sizes[t] + 1), dtype=bool)
-            if (s, t) in compatible:
-                C = np.asarray(compatible[(s, t)], dtype=bool)
-                if C.shape != (sizes[s], sizes[t]):
-                    raise InvalidProblemError(
-                        f"compatibility of sensors ({s}, {t}) must have shape "
-                        f"({sizes[s]}, {sizes[t]}), got {C.shape}")
-                M[1:, 1:] = C
-            out[(s, t)] = M
     for key in compatible:
-        if key not in out:
+        if not (isinstance(key, tuple) and len(key) == 2 and
+                all(isinstance(v, (int, np.integer)) for v in key) and
+                0 <= key[0] < key[1] < N):
             raise InvalidProblemError(f"compatibility key {key} must be a sensor pair "
                                       f"(s, t) with 0 <= s < t < {N}")
+    out: dict = {}
+    for s in range(N):
+        for t in range(s + 1, N):
+            if (s, t) not in compatible:
+                out[(s, t)] = None
+                continue
+            M = np.ascontiguousarray(compatible[(s, t)], dtype=bool)
+            if M.shape != (sizes[s], sizes[t]):
+                raise InvalidProblemError(
+                    f"compatibility of sensors ({s}, {t}) must have shape "
+                    f"({sizes[s]}, {sizes[t]}), got {M.shape}")
+            flat = np.flatnonzero(M)
+            ptr = np.zeros(sizes[s] + 1, np.int64)
+            np.cumsum(np.bincount(flat // max(sizes[t], 1), minlength=sizes[s]),
+                      out=ptr[1:])
+            out[(s, t)] = (M, ptr, flat % max(sizes[t], 1))
     return out
 
 

@@ -1,0 +1,90 @@
+"""``bnb`` over a batch of independent components, in one compiled call.
+
+Used by :mod:`assocopt.solving.decompose`: the components ``bnb`` suits are concatenated
+(each relabelled to its own indices) and handed to
+:func:`assocopt.solvers.kernels.batch.solve_batch`, which runs ``bnb``'s ascent and
+search on each in turn, at ``bnb``'s default settings (or those given with
+``solver="bnb"``).  Components whose node budget runs out are returned to the
+caller, which solves them alone (``lagrangian-exact``); a time limit or Ctrl-C stops
+the call between two ascent iterations or 1024 search nodes (a batch of more than
+``bnb.INLINE_CANDIDATES`` candidates runs in a worker thread, as ``bnb`` does).
+"""
+
+from __future__ import annotations
+
+from typing import Any
+
+import numpy as np
+
+from ..model.solution import Status
+from .base import SolveOptions
+from .bnb import DEFAULTS, INLINE_CANDIDATES, TOL
+from .interruptible import new_stop, run_stoppable
+
+__all__ = ["solve_components", "batch_arrays", "run_batch"]
+
+
+def batch_arrays(T: np.ndarray, costs: np.ndarray, parts: list[np.ndarray]
+                 ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """``(T, c, kp)`` of the kernel: the candidates of each part (positions into
+    ``T`` / ``costs``) one after the other, ``kp`` where each part starts."""
+    kp = np.zeros(len(parts) + 1, np.int64)
+    np.cumsum([len(p) for p in parts], out=kp[1:])
+    cand = np.concatenate(parts) if parts else np.zeros(0, np.int64)
+    return np.ascontiguousarray(T[cand]), np.ascontiguousarray(costs[cand]), kp
+
+
+def run_batch(T: np.ndarray, c: np.ndarray, kp: np.ndarray, sizes: np.ndarray,
+              params: dict[str, Any] | None = None, deadline: float | None = None
+              ) -> tuple[tuple[np.ndarray, ...], bool]:
+    """The kernel on ``(T, c, kp, sizes)`` (local tuples, ``sizes`` (parts, N)):
+    ``((outcome, ub, bound, chosen), stopped_by_clock)``."""
+    from .kernels import ensure
+    from .kernels.batch import solve_batch
+    p = dict(DEFAULTS, **(params or {}))
+    args = (np.ascontiguousarray(T, np.int64), np.ascontiguousarray(c, np.float64),
+            kp, np.ascontiguousarray(sizes, np.int64), TOL, p["max_iter"],
+            p["probe_every"], p["probe_nodes"], p["max_nodes"], p["step0"], p["patience"],
+            p["step_min"], p["deflect"], p["recover_every"], p["warm_start"],
+            p["stall_tol"], new_stop())
+    ensure(solve_batch, *args)
+    return run_stoppable(solve_batch, args, args[-1], deadline=deadline,
+                         inline=len(T) <= INLINE_CANDIDATES)
+
+
+def solve_components(problem: Any, T: np.ndarray, csizes: np.ndarray, sp: Any,
+                     comps: np.ndarray, opts: SolveOptions, left: float | None,
+                     out: Any) -> np.ndarray:
+    """Solve components ``comps`` of the split ``sp`` in one kernel call, adding
+    their answers to ``out`` (:class:`assocopt.solving.decompose._Outcome`); returns the
+    components whose node budget ran out, for the caller to solve alone."""
+    import time
+    if len(comps) == 0:
+        return comps
+    parts = [sp.order[sp.ptr[c]:sp.ptr[c + 1]] for c in comps]
+    Tb, cb, kp = batch_arrays(T, problem.costs, parts)
+    params = {k: v for k, v in opts.extra.items() if k in DEFAULTS} \
+        if opts.parsed else {}
+    params.pop("keep_axes", None)
+    params.pop("fallback", None)
+    deadline = None if left is None else time.perf_counter() + max(left, 0.0)
+    (outcome, ub, lb, chosen), by_clock = run_batch(Tb, cb, kp, csizes[comps], params,
+                                                    deadline)
+    from .kernels.driver import INFEASIBLE, PROVEN
+    proven = outcome == PROVEN
+    found = np.isfinite(ub)
+    cand = np.concatenate(parts)
+    ok = proven & found
+    if ok.any():
+        sel = cand[chosen.astype(bool)]
+        out.add(Status.OPTIMAL, sel, float(ub[ok].sum()), "bnb", int(ok.sum()))
+    bad = (outcome == INFEASIBLE) | (proven & ~found)
+    if bad.any():
+        out.add(Status.INFEASIBLE, None, None, "bnb", int(bad.sum()),
+                "a component admits no exact cover")
+    stopped = ~proven & ~(outcome == INFEASIBLE)
+    if by_clock and stopped.any():
+        out.add(Status.TIME_LIMIT, None, None, "bnb", int(stopped.sum()),
+                "stopped by the time limit")
+        return comps[:0]
+    return comps[stopped]

@@ -1,0 +1,46 @@
+"""Which back end ``solver="auto"`` picks for a problem, by size and structure.
+
+Kept apart from :mod:`assocopt.solving.api` so that :mod:`assocopt.solving.decompose`
+can choose per component without importing ``solve``.
+"""
+from __future__ import annotations
+
+from ..problems.problem import AssignmentProblem
+from ..solvers.base import module_installed
+
+__all__ = ["choose_solver", "BNB_MAX_CANDIDATES", "BNB_MAX_KEPT"]
+
+
+#: ``auto`` sends N >= 3 problems with at most this many candidates to ``bnb``
+#: (compiled branch and bound) when numba is installed; measured faster than
+#: ``lagrangian-exact`` up to Grundel n = 20 (8,000 candidates), slower at n = 30
+#: (docs/benchmarks-sd.md).
+BNB_MAX_CANDIDATES = 10_000
+#: ... and with at most this many real indices on the two kept axes: ``bnb``'s dense
+#: Hungarian costs O((n_a + n_b)^3) per iteration, ``lagrangian-exact``'s sparse LAP
+#: far less on large sparse problems.
+BNB_MAX_KEPT = 100
+
+
+def choose_solver(problem: AssignmentProblem, relax: str | None = None) -> str:
+    """The back end ``solver="auto"`` picks, by size and structure (measured in
+    docs/benchmarks-sd.md): the 2-D fast path; for S-D (N >= 3) the compiled branch
+    and bound ``bnb`` up to :data:`BNB_MAX_CANDIDATES` candidates and
+    :data:`BNB_MAX_KEPT` kept-axes indices (numba installed), else the Lagrangian exact
+    method; HiGHS for LP relaxations."""
+    if relax is not None:
+        return "highs"
+    if problem.ndim == 2:
+        return "scipy-lsa"
+    if problem.n_candidates <= BNB_MAX_CANDIDATES and _bnb_usable(problem):
+        return "bnb"
+    return "lagrangian-exact"
+
+
+def _bnb_usable(problem: AssignmentProblem) -> bool:
+    from ..solvers.bnb import kept_sizes
+    return _numba_installed() and sum(kept_sizes(problem)) <= BNB_MAX_KEPT
+
+
+def _numba_installed() -> bool:
+    return module_installed("numba")

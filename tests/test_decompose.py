@@ -1,0 +1,221 @@
+"""Connected components (assocopt.solving.decompose) and the batched bnb kernel.
+
+Problems are drawn as several independent blocks side by side (disjoint index
+ranges), with isolated indices (a real index whose only candidate is its singleton)
+and blocks made of singletons only; decomposed and whole solves must agree on status
+and objective, and every answer is feasible (``assert_optimal`` checks it against
+brute force).  The batch kernel is checked component by component against the
+``bruteforce`` back end.  No timing asserts.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
+
+from assocopt import AssignmentProblem, Status, solve
+from assocopt.solving.decompose import local_tuples, split
+from assocopt.testing import assert_optimal
+
+
+@st.composite
+def blocks(draw, N: int | None = None, feasible: bool = True):
+    """``(sizes, tuples, costs)`` of one block: a random subset of its tuples, every
+    index covered; ``feasible``: every singleton is a candidate."""
+    N = N or draw(st.integers(3, 4))
+    sizes = tuple(draw(st.integers(0, 2)) for _ in range(N))
+    if sum(sizes) == 0:
+        sizes = (1,) + sizes[1:]
+    grids = np.meshgrid(*[np.arange(n + 1) for n in sizes], indexing="ij")
+    T = np.stack([g.ravel() for g in grids], axis=1)[1:]          # no all-dummy
+    single = (T > 0).sum(axis=1) == 1
+    keep = np.array(draw(st.lists(st.booleans(), min_size=len(T), max_size=len(T))))
+    keep |= single if feasible else np.zeros(len(T), bool)
+    T = T[keep]
+    for s, n in enumerate(sizes):                  # cover every index at least once
+        for i in range(1, n + 1):
+            if not (T[:, s] == i).any():
+                t = np.zeros((1, N), np.int64)
+                t[0, s] = i
+                T = np.concatenate([T, t])
+    costs = np.array(draw(st.lists(st.integers(-6, 6), min_size=len(T),
+                                   max_size=len(T))), float) / 2
+    return sizes, T, costs
+
+
+@st.composite
+def side_by_side(draw, feasible: bool | None = None):
+    """Several blocks in disjoint index ranges, plus isolated indices and
+    singleton-only blocks, in a shuffled order of candidates."""
+    N = draw(st.integers(3, 4))
+    parts = draw(st.lists(blocks(N, feasible if feasible is not None else
+                                 draw(st.booleans())), min_size=1, max_size=4))
+    n_iso = draw(st.integers(0, 3))
+    for _ in range(n_iso):                          # isolated index: singleton alone
+        s = draw(st.integers(0, N - 1))
+        sizes = tuple(1 if t == s else 0 for t in range(N))
+        T = np.zeros((1, N), np.int64)
+        T[0, s] = 1
+        parts.append((sizes, T, np.array([float(draw(st.integers(-3, 3)))])))
+    sizes = np.zeros(N, np.int64)
+    Ts, cs = [], []
+    for sz, T, c in parts:
+        Ts.append(np.where(T > 0, T + sizes, 0))
+        cs.append(c)
+        sizes += np.asarray(sz)
+    T, c = np.concatenate(Ts), np.concatenate(cs)
+    perm = np.array(draw(st.permutations(range(len(T)))), np.int64)
+    return AssignmentProblem.sparse(tuple(int(v) for v in sizes), T[perm], c[perm])
+
+
+def _agree(a, b):
+    assert a.status is b.status, (a, b)
+    if a.status is Status.OPTIMAL:
+        assert abs(a.objective - b.objective) <= 1e-9 * max(1.0, abs(b.objective))
+        assert abs(a.bound - a.objective) <= 1e-9 * max(1.0, abs(a.objective))
+
+
+@settings(max_examples=60)
+@given(side_by_side())
+def test_decomposed_equals_whole(p):
+    whole = solve(p, "bruteforce", decompose=False)
+    if whole.status is Status.TIME_LIMIT:     # past its node cap: HiGHS on the whole
+        whole = solve(p, "highs", decompose=False)
+    for solver in ("highs", "auto", "bruteforce", "lagrangian-exact"):
+        sol = solve(p, solver, decompose=True)
+        _agree(sol, whole)
+        if sol.status is Status.OPTIMAL:
+            assert_optimal(p, sol)
+            assert sol.info["decomposition"]["components"] >= 1
+
+
+@settings(max_examples=30)
+@given(side_by_side(feasible=True))
+def test_components_counted(p):
+    sp = split(p)
+    # brute force over the component graph: candidates sharing a row are connected
+    R = p.entry_rows
+    lab = np.arange(p.n_rows)
+    changed = True
+    while changed:
+        changed = False
+        for r in R:
+            rr = r[r >= 0]
+            m = lab[rr].min()
+            for x in rr:
+                if lab[x] != m:
+                    lab[lab == lab[x]] = m
+                    changed = True
+    assert sp.n == len(np.unique(lab))
+    same = sp.of_row[:, None] == sp.of_row[None, :]
+    assert (same == (lab[:, None] == lab[None, :])).all()
+    T, sizes = local_tuples(p, sp.of_row, sp.n)
+    assert (sizes.sum(axis=0) == np.asarray(p.sizes)).all()
+    for c in range(sp.n):                      # local indices: 1..n_cs on each axis
+        cand = sp.order[sp.ptr[c]:sp.ptr[c + 1]]
+        for s in range(p.ndim):
+            used = np.unique(T[cand, s][T[cand, s] > 0])
+            assert (used == np.arange(1, sizes[c, s] + 1)).all()
+
+
+def test_singletons_only_settled_without_solver():
+    T = np.array([[1, 0, 0], [0, 1, 0], [0, 0, 1], [2, 0, 0]])
+    p = AssignmentProblem.sparse((2, 1, 1), T, [1.0, -2.0, 0.5, 3.0])
+    sol = solve(p, "highs", decompose=True)
+    assert sol.status is Status.OPTIMAL and sol.objective == 2.5
+    d = sol.info["decomposition"]
+    assert d["components"] == 4 and d["settled"] == 4 and d["largest"] == 1
+
+
+def test_decompose_false_and_time_limit():
+    rng = np.random.default_rng(1)
+    T = np.array([[i, j, k] for i in range(3) for j in range(3) for k in range(3)
+                  if (i, j, k) != (0, 0, 0)])
+    p1 = AssignmentProblem.sparse((2, 2, 2), T, rng.normal(size=len(T)))
+    # two copies side by side: two components
+    T2 = np.concatenate([T, np.where(T > 0, T + 2, 0)])
+    p = AssignmentProblem.sparse((4, 4, 4), T2, np.tile(p1.costs, 2))
+    whole = solve(p, "highs", decompose=False)
+    assert "decomposition" not in whole.info
+    for solver in ("highs", "auto", "scipy"):
+        sol = solve(p, solver, decompose=True, time_limit=30.0)
+        _agree(sol, whole)
+        assert sol.info["decomposition"]["components"] == 2
+    assert abs(whole.objective - 2 * solve(p1, "highs").objective) < 1e-9
+
+
+def test_infeasible_component_makes_whole_infeasible():
+    # block 1: index 1 of axis 0 must pair with index 1 of axis 1, which has no
+    # singleton and whose only other candidate clashes: infeasible
+    T = np.array([[1, 1, 0], [0, 1, 1], [0, 0, 1], [2, 0, 0]])
+    p = AssignmentProblem.sparse((2, 1, 1), T, [1.0, 1.0, 1.0, 0.0])
+    for solver in ("highs", "auto", "bruteforce"):
+        a = solve(p, solver, decompose=True)
+        b = solve(p, solver, decompose=False)
+        assert a.status is b.status
+
+
+@settings(max_examples=40)
+@given(st.lists(blocks(3), min_size=1, max_size=5))
+def test_batch_kernel_equals_brute_force(parts):
+    pytest.importorskip("numba")
+    from assocopt.solvers.bnb_batch import run_batch
+    from assocopt.solvers.kernels.driver import INFEASIBLE, PROVEN
+    Ts, cs, szs, kp = [], [], [], [0]
+    for sizes, T, c in parts:
+        Ts.append(T)
+        cs.append(c)
+        szs.append(sizes)
+        kp.append(kp[-1] + len(T))
+    (outcome, ub, lb, chosen), _ = run_batch(np.concatenate(Ts), np.concatenate(cs),
+                                             np.array(kp), np.array(szs))
+    for i, (sizes, T, c) in enumerate(parts):
+        ref = solve(AssignmentProblem.sparse(sizes, T, c), "bruteforce")
+        if ref.status is Status.INFEASIBLE:
+            assert outcome[i] == INFEASIBLE or not np.isfinite(ub[i])
+            continue
+        assert outcome[i] == PROVEN
+        assert abs(ub[i] - ref.objective) <= 1e-9 * max(1.0, abs(ref.objective))
+        sel = np.flatnonzero(chosen[kp[i]:kp[i + 1]])
+        assert abs(c[sel].sum() - ref.objective) <= 1e-9 * max(1.0, abs(ref.objective))
+        p = AssignmentProblem.sparse(sizes, T, c)
+        assert p.violations(sel) is None
+        assert lb[i] <= ub[i] + 1e-9
+
+
+def test_time_limit_is_shared_and_a_stopped_component_stops_the_whole():
+    T = np.array([[i, j, k] for i in range(3) for j in range(3) for k in range(3)
+                  if (i, j, k) != (0, 0, 0)])
+    T2 = np.concatenate([T, np.where(T > 0, T + 2, 0)])
+    c = np.random.default_rng(3).normal(size=len(T2))
+    p = AssignmentProblem.sparse((4, 4, 4), T2, c)
+    sol = solve(p, "highs", decompose=True, time_limit=1e-9)
+    assert sol.status is Status.TIME_LIMIT and sol.selected is None
+    assert sol.info["decomposition"]["components"] == 2
+
+
+def test_maximize_decomposed():
+    T = np.array([[1, 1, 0], [1, 0, 0], [0, 1, 0], [2, 0, 2], [2, 0, 0], [0, 0, 2],
+                  [0, 0, 1], [0, 2, 0]])
+    p = AssignmentProblem.sparse((2, 2, 2), T, [3.0, 1.0, 1.0, -1.0, 0.5, 0.25, 0.0, 0.0],
+                                 maximize=True)
+    for solver in ("highs", "auto"):
+        a = solve(p, solver, decompose=True)
+        b = solve(p, "bruteforce", decompose=False)
+        assert a.objective == b.objective == 3.75 and a.bound == 3.75
+
+
+@settings(max_examples=30)
+@given(side_by_side())
+def test_batch_budget_spent_components_are_solved_again(p):
+    """bnb's batch with a node budget of 1: the components it cannot prove go to
+    bnb alone (and its fallback), and the whole is still exact."""
+    pytest.importorskip("numba")
+    whole = solve(p, "bruteforce", decompose=False)
+    sol = solve(p, "bnb", decompose=True, max_nodes=1, max_iter=1, probe_every=0,
+                recover_every=0)
+    _agree(sol, whole)
+    if sol.status is Status.OPTIMAL:
+        assert_optimal(p, sol)
