@@ -18,6 +18,7 @@ import matplotlib.pyplot as plt
 
 from assocopt.reproduce.yan2010 import make_figures
 
+# the committed run: docs/papers/yan2010/summary.json (this script runs in docs/gallery/papers)
 summary = json.loads(Path("../../papers/yan2010/summary.json").read_text())
 print(summary["title"])
 print(f"{summary['runs']} Monte Carlo runs, master seed {summary['seed']}")

@@ -19,6 +19,7 @@ import matplotlib.pyplot as plt
 
 from assocopt.reproduce.xue1999 import DEFAULTS, make_figures
 
+# the committed run: docs/papers/xue1999/summary.json (this script runs in docs/gallery/papers)
 summary = json.loads(Path("../../papers/xue1999/summary.json").read_text())
 print(summary["title"])
 print(f"{summary['runs']} Monte Carlo runs, master seed {summary['seed']}")

@@ -19,6 +19,7 @@ import matplotlib.pyplot as plt
 
 from assocopt.reproduce.lu2013 import make_figures
 
+# the committed run: docs/papers/lu2013/summary.json (this script runs in docs/gallery/papers)
 summary = json.loads(Path("../../papers/lu2013/summary.json").read_text())
 print(summary["title"])
 print(f"{summary['runs']} Monte Carlo runs, master seed {summary['seed']}")

@@ -18,6 +18,7 @@ import matplotlib.pyplot as plt
 
 from assocopt.reproduce.zhang2009 import make_figures
 
+# the committed run: docs/papers/zhang2009/summary.json (this script runs in docs/gallery/papers)
 summary = json.loads(Path("../../papers/zhang2009/summary.json").read_text())
 print(summary["title"])
 print(f"{summary['runs']} Monte Carlo runs, master seed {summary['seed']}")

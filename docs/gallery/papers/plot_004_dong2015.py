@@ -19,6 +19,7 @@ import matplotlib.pyplot as plt
 
 from assocopt.reproduce.dong2015 import make_figures
 
+# the committed run: docs/papers/dong2015/summary.json (this script runs in docs/gallery/papers)
 summary = json.loads(Path("../../papers/dong2015/summary.json").read_text())
 print(summary["title"])
 print(f"{summary['runs']} Monte Carlo runs, master seed {summary['seed']}")
