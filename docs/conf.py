@@ -27,7 +27,6 @@ extensions = [
     "sphinx.ext.autodoc",
     "sphinx.ext.autosummary",
     "sphinx.ext.mathjax",
-    "sphinx.ext.intersphinx",
     "numpydoc",
     "myst_nb",
     "sphinx_gallery.gen_gallery",
@@ -50,7 +49,6 @@ autodoc_typehints = "none"                 # the numpydoc Parameters say the typ
 numpydoc_show_class_members = False
 numpydoc_class_members_toctree = False
 numpydoc_xref_param_type = False
-intersphinx_mapping = {}                   # the build reads nothing from the network
 
 # -- Markdown and notebooks ------------------------------------------------------
 myst_enable_extensions = ["dollarmath", "amsmath", "colon_fence", "deflist"]

@@ -148,7 +148,7 @@ def backends_rst() -> list[str]:
              c.distribution or c.module or "(numpy / own)"]
             for name, c in sorted(registered().items())]
     lines = _title("Capabilities", "-") + _table(
-        ["back end", "ILP", "LP", "axes", "exact", "bound", "time limit", "package"], caps)
+        ["back end", "integer solution", "LP relaxation", "axes", "exact", "bound", "time limit", "package"], caps)
     opt_head = ["option", "accepts", "default", "description"]
     lines += _title("Common options (every back end)", "-") + _table(
         opt_head, [[_lit(o.name), o.describe(), _lit(o.default_text()), o.doc]
