@@ -148,7 +148,8 @@ def backends_rst() -> list[str]:
              c.distribution or c.module or "(numpy / own)"]
             for name, c in sorted(registered().items())]
     lines = _title("Capabilities", "-") + _table(
-        ["back end", "integer solution", "LP relaxation", "axes", "exact", "bound", "time limit", "package"], caps)
+        ["back end", "integer solution", "LP relaxation", "axes", "exact", "bound",
+         "time limit", "package"], caps)
     opt_head = ["option", "accepts", "default", "description"]
     lines += _title("Common options (every back end)", "-") + _table(
         opt_head, [[_lit(o.name), o.describe(), _lit(o.default_text()), o.doc]
@@ -192,7 +193,9 @@ def _no_type_doc(app, what, name, obj, options, lines) -> None:
     if what in ("data", "attribute") and not inspect.isclass(obj) and lines \
             and isinstance(doc, str):
         own = inspect.cleandoc(doc).splitlines()
-        if [ln.rstrip() for ln in lines if ln.strip()] == [ln.rstrip() for ln in own if ln.strip()]:
+        def body(text: list[str]) -> list[str]:
+            return [ln.rstrip() for ln in text if ln.strip()]
+        if body(lines) == body(own):
             lines.clear()
 
 

@@ -3,10 +3,9 @@ Comparing back ends
 ===================
 
 Every back end answers the same problem with the same :class:`~assocopt.Solution`, so
-comparing them is a loop.  Random axial 3-D problems of growing size (integer costs, which CP-SAT solves
-without scaling) are solved by the
-general MILP solvers and by assocopt's own Lagrangian solvers; all proven optima agree,
-and the plot shows the time each took (build + solve, one run on the machine that
+comparing them is a loop.  Random axial 3-D problems of growing size (integer costs,
+which CP-SAT solves without scaling) are solved by the general MILP solvers and by
+assocopt's own Lagrangian solvers; all proven optima agree, and the plot shows the time each took (build + solve, one run on the machine that
 built this page, so only the trend means anything; ``benchmarks/`` has the measured
 comparisons).
 """
