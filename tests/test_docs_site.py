@@ -241,3 +241,12 @@ def test_the_raw_markdown_pattern_can_fail():
         assert _RAW_MARKDOWN.search(text), text
     for text in ("a (b) [c]", "x # y", "f(x)[0]"):
         assert not _RAW_MARKDOWN.search(text), text
+
+
+def test_constants_do_not_show_the_docstring_of_their_type(site, pages):
+    """A tuple or dict constant without a ``#:`` comment shows no text rather than
+    ``tuple``'s or ``dict``'s own docstring."""
+    typed = [f.relative_to(site) for f, page in pages.items()
+             if any(s in " ".join(page.text) for s in ("Built-in immutable sequence",
+                                                       "new empty dictionary"))]
+    assert not typed, typed[:20]

@@ -216,7 +216,7 @@ def _folder_links(app, docname: str, source: list[str]) -> None:
 
 def setup(app):
     app.connect("config-inited", _on_config)
-    app.connect("autodoc-process-docstring", _no_type_doc)
+    app.connect("autodoc-process-docstring", _no_type_doc, priority=100)   # before numpydoc
     app.connect("source-read", _folder_links)
     app.add_directive("assocopt-backends", _directive())
     return {"parallel_read_safe": True, "parallel_write_safe": True}
