@@ -38,18 +38,20 @@ DOCS = ROOT / "docs"
 GENERATED = ("_build", "auto_examples", "api/generated", "sg_execution_times.rst")
 
 
+def _sources_only(folder: str, names: list[str]) -> list[str]:
+    """copytree's filter: leave out what a build generated and caches."""
+    rel = Path(folder).relative_to(DOCS)
+    skip = {"__pycache__", ".ipynb_checkpoints"}
+    skip |= {Path(g).name for g in GENERATED if Path(g).parent == rel}
+    return [n for n in names if n in skip]
+
+
 @pytest.fixture(scope="module")
 def site(tmp_path_factory) -> Path:
     """Build the site from a copy of docs/; returns the HTML folder."""
     work = tmp_path_factory.mktemp("site")
     src = work / "docs"
-    shutil.copytree(DOCS, src, ignore=shutil.ignore_patterns("__pycache__", ".ipynb_checkpoints"))
-    for g in GENERATED:
-        p = src / g
-        if p.is_dir():
-            shutil.rmtree(p)
-        elif p.exists():
-            p.unlink()
+    shutil.copytree(DOCS, src, ignore=_sources_only)
     out = work / "html"
     env = {k: v for k, v in os.environ.items() if k != "MPLBACKEND"}   # notebooks: inline
     env["PYTHONPATH"] = str(ROOT) + os.pathsep + os.environ.get("PYTHONPATH", "")
