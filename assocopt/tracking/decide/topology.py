@@ -14,28 +14,28 @@ costs far more in model building than in solving (measured on the page).
 :func:`phi_reference` does the same through ``solve``, one pair at a time; the tests
 check that both agree.
 
-Options (:class:`TopologyParams`; every reading not fixed by the paper is named):
+Options (:class:`TopologyParams`; every reading not fixed by the paper is named)::
 
-``metric``      ``"statistical"`` (gamma, the paper's) or ``"euclidean"`` (squared
-                distance of the positions, the Euclidean baseline);
-``frame``       ``"position"`` (positions translated, velocities rotated) or ``"full"``
-                (whole state subtracted; the reference pair is then left out of
-                lambda, since it is the zero vector on both sensors);
-``assignment``  ``"dummy"`` (default: a dummy per row and column at half the gate,
-                so a pair is used only when it beats leaving both tracks out; solved
-                over the gated entries only, which is exact and fast) or
-                ``"rectangular"`` (the smaller side fully assigned, then gated; every
-                pair needs a full n x n Hungarian, about 15x slower at 30 targets);
-``inflate``     add the reference headings' variance to B (ours);
-``ref_cov``     first-order covariance of the offsets from the reference: adds the
-                reference's own position covariance (ours; the paper rotates P_i only);
-``degree``      ``"mean"`` (the paper's lambda: mean gamma over the confirmed pairs) or
-                ``"objective"`` (ours: the assignment cost per track with every
-                unconfirmed track at the gate, so a pair confirming few neighbours can
-                no longer beat one confirming many);
-``threshold``   ``"chi2"`` (gate delta(alpha, 4), or ``euclid_gate_m^2``) or
-                ``"heading"``: our substitute for the paper's lost threshold T_1,
-                ``gate * (1 + coef * (var(theta_1u) + var(theta_2v)))`` (flagged as ours).
+    ``metric``      ``"statistical"`` (gamma, the paper's) or ``"euclidean"`` (squared
+                    distance of the positions, the Euclidean baseline);
+    ``frame``       ``"position"`` (positions translated, velocities rotated) or ``"full"``
+                    (whole state subtracted; the reference pair is then left out of
+                    lambda, since it is the zero vector on both sensors);
+    ``assignment``  ``"dummy"`` (default: a dummy per row and column at half the gate,
+                    so a pair is used only when it beats leaving both tracks out; solved
+                    over the gated entries only, which is exact and fast) or
+                    ``"rectangular"`` (the smaller side fully assigned, then gated; every
+                    pair needs a full n x n Hungarian, about 15x slower at 30 targets);
+    ``inflate``     add the reference headings' variance to B (ours);
+    ``ref_cov``     first-order covariance of the offsets from the reference: adds the
+                    reference's own position covariance (ours; the paper rotates P_i only);
+    ``degree``      ``"mean"`` (the paper's lambda: mean gamma over the confirmed pairs) or
+                    ``"objective"`` (ours: the assignment cost per track with every
+                    unconfirmed track at the gate, so a pair confirming few neighbours can
+                    no longer beat one confirming many);
+    ``threshold``   ``"chi2"`` (gate delta(alpha, 4), or ``euclid_gate_m^2``) or
+                    ``"heading"``: our substitute for the paper's lost threshold T_1,
+                    ``gate * (1 + coef * (var(theta_1u) + var(theta_2v)))`` (flagged as ours).
 """
 
 from __future__ import annotations

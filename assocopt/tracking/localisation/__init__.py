@@ -4,7 +4,7 @@ One module per concept: :mod:`.geometry` (angles, Jacobians, line-of-sight syste
 :mod:`.estimate` (the estimators), :mod:`.pseudo` (pseudo-measurements).
 
 Conventions (docs/papers/lu2013.md)
----------------------------
+-----------------------------------
 * Angles are in **radians** everywhere inside the library; positions in any length
   unit (the paper's scenarios use km).  Only scenario files and reports use mrad.
 * A sensor measures ``theta = [alpha, beta]``: **elevation first**, then azimuth.

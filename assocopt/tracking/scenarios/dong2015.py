@@ -9,7 +9,7 @@ period 4 s; 12 steps; 30 targets in straight-line motion.  Environments:
    400 m/s with heading 60 degrees;
 2. random targets: positions uniform in the square (50, 50)-(60, 60) km, speed uniform
    in 150-220 m/s, heading uniform in [0, 2 pi);
-3. environment 2 with a common observation rate P_c = |U1 n U2| / |U1 u U2| = 0.5.
+3. environment 2 with a common observation rate P_c = ``|U1 n U2| / |U1 u U2|`` = 0.5.
 
 Ours (named fields, :data:`OURS`): azimuth and heading measured clockwise from north
 (so environment 1's 60 degrees points north-east); how P_c = 0.5 is produced
@@ -73,7 +73,7 @@ class Run:
 
     @property
     def common_observation_rate(self) -> float:
-        """P_c = |U1 n U2| / |U1 u U2| (false tracks count as observed targets)."""
+        """P_c = ``|U1 n U2| / |U1 u U2|`` (false tracks count as observed targets)."""
         union = len(set(self.ids1.tolist()) | set(self.ids2.tolist()))
         return self.n_common / union if union else math.nan
 

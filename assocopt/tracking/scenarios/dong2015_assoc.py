@@ -2,28 +2,28 @@
 simulated run, and the metrics (defined once here; the page repeats them).
 
 Topology methods (per step: Phi by :func:`~assocopt.tracking.decide.topology.phi_matrix`,
-trial pairs, then the double-threshold rule over the steps):
+trial pairs, then the double-threshold rule over the steps)::
 
-``tsd``          the topology statistical distance as reconstructed: positions
-                 translated, velocities rotated, dummies at the gate, chi-square gate
-                 delta(0.01, 4), row-wise trial pairs, dynamic I/R;
-``tsd-t1``       the same with our substitute for the lost heading threshold T_1
-                 (``coef`` = the threshold coefficient; 20 as the paper's C_1);
-``tsd-full``     full-state frame, reference pair left out of lambda;
-``tsd-rect``     rectangular assignment, then gate;
-``tsd-global``   trial pairs by a global 2-D assignment on Phi;
-``tsd-min5``     lambda only from at least 5 confirmed pairs;
-``tsd-obj``      lambda = the assignment cost per track, unconfirmed tracks at the
-                 gate (ours);
-``tsd-inflate``  ``tsd-obj`` with the reference-heading variance added to B (ours);
-``tsd-c``        ``tsd-inflate`` with the reference's position covariance added
-                 (ours: all three corrections); ``tsd-c-pregate`` with the coarse
-                 speed pre-gate, ``tsd-c-global`` with global trial pairs;
-``ted``          the Euclidean baseline: squared distance of the positions in the
-                 reference frames, gate ``euclid_gate_m`` (ours: the paper's Euclidean
-                 coefficient is lost), otherwise as ``tsd``; ``ted-obj`` with our
-                 objective degree; ``ted-t1`` with the substitute threshold;
-``tsd-obj-t1``, ``ted-obj-t1`` the objective degree with the substitute threshold.
+    ``tsd``          the topology statistical distance as reconstructed: positions
+                     translated, velocities rotated, dummies at the gate, chi-square gate
+                     delta(0.01, 4), row-wise trial pairs, dynamic I/R;
+    ``tsd-t1``       the same with our substitute for the lost heading threshold T_1
+                     (``coef`` = the threshold coefficient; 20 as the paper's C_1);
+    ``tsd-full``     full-state frame, reference pair left out of lambda;
+    ``tsd-rect``     rectangular assignment, then gate;
+    ``tsd-global``   trial pairs by a global 2-D assignment on Phi;
+    ``tsd-min5``     lambda only from at least 5 confirmed pairs;
+    ``tsd-obj``      lambda = the assignment cost per track, unconfirmed tracks at the
+                     gate (ours);
+    ``tsd-inflate``  ``tsd-obj`` with the reference-heading variance added to B (ours);
+    ``tsd-c``        ``tsd-inflate`` with the reference's position covariance added
+                     (ours: all three corrections); ``tsd-c-pregate`` with the coarse
+                     speed pre-gate, ``tsd-c-global`` with global trial pairs;
+    ``ted``          the Euclidean baseline: squared distance of the positions in the
+                     reference frames, gate ``euclid_gate_m`` (ours: the paper's Euclidean
+                     coefficient is lost), otherwise as ``tsd``; ``ted-obj`` with our
+                     objective degree; ``ted-t1`` with the substitute threshold;
+    ``tsd-obj-t1``, ``ted-obj-t1`` the objective degree with the substitute threshold.
 
 Position baselines on the biased tracks (each step on its own, no I/R):
 ``nn`` (each sensor-1 track its nearest sensor-2 track in Mahalanobis distance of the

@@ -86,8 +86,8 @@ class Draw:
 
 
 def confusion_sets(n_types: int, size: int, includes_true: bool) -> np.ndarray:
-    """Bitmask of each type's confusion set (ours): types ``k+1 .. k+size-1`` mod n,
-    plus ``k`` itself when ``includes_true`` (otherwise ``k+1 .. k+size``)."""
+    """Bitmask of each type's confusion set (ours): types ``k+1`` to ``k+size-1`` mod n,
+    plus ``k`` itself when ``includes_true`` (otherwise ``k+1`` to ``k+size``)."""
     k = np.arange(n_types)
     offsets = range(0, size) if includes_true else range(1, size + 1)
     masks = np.zeros(n_types, dtype=np.int64)
