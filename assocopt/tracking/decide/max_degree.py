@@ -216,6 +216,13 @@ class TrackAssociator:
 
     def step(self, D: np.ndarray, f1: np.ndarray, f2: np.ndarray) -> np.ndarray:
         o, ctr = self.options, self.counter
+        n1, n2 = ctr.delta.shape
+        D, f1, f2 = np.asarray(D, float), np.asarray(f1, float), np.asarray(f2, float)
+        if D.shape != (n1, n2):
+            raise ValueError(f"D must have shape ({n1}, {n2}), got {D.shape}")
+        if f1.shape != (n1, 3) or f2.shape != (n2, 3):
+            raise ValueError(f"features must have shapes ({n1}, 3) and ({n2}, 3), got "
+                             f"{f1.shape} and {f2.shape}")
         rows, cols = np.flatnonzero(ctr.open_rows), np.flatnonzero(ctr.open_cols)
         sub = np.full(len(rows), -1)
         if len(rows) and len(cols):
@@ -228,7 +235,8 @@ class TrackAssociator:
                 sub = (max_degree_rule(m, o.eps) if o.rule == "max-degree" else
                        assignment_rule(m, o.eps, o.cost, o.solver))
         partner = np.full(D.shape[0], -1)
-        partner[rows] = np.where(sub >= 0, cols[np.maximum(sub, 0)], -1)
+        took = sub >= 0                      # no open column left: every open row gets -1
+        partner[rows[took]] = cols[sub[took]]
         self.last_open_partner = partner.copy()
         out = np.where(ctr.fixed >= 0, ctr.fixed, partner)
         ctr.update(partner)
