@@ -7,6 +7,8 @@ Four experiments, each with its own results store ``OUT/yan2010-*.sqlite``:
                  reading, our 2-D assignment counterpart and the weighted test.
 ``fig4``         the correct rate at every scan for 60 targets, every method.
 ``sensitivity``  ours: 100 targets, one open parameter changed at a time.
+``grid``         ours: 10..100 targets, single-node fraction x feature set, the paper's
+                 rule against the 2-D assignment, counter or not, tolerance factor 2 or 1.
 ``three_node``   ours: a third TDOA system and one S-D assignment over the three.
 
 Every method of a trial decides on the same simulated run (paired comparison).  The
@@ -27,7 +29,7 @@ from .report import make_figures, render_tables  # noqa: F401
 __all__ = ["PAPER_TABLE1", "TABLE1_N", "DEFAULTS", "METHODS", "experiments", "trial",
            "parameters", "run", "render_tables", "make_figures"]
 
-PARTS = ("table1", "fig4", "sensitivity", "three_node")
+PARTS = ("table1", "fig4", "sensitivity", "grid", "three_node")
 
 
 def run(runs: int, workers: int, seed: int, out, *, progress: bool = False,
@@ -45,7 +47,7 @@ def run(runs: int, workers: int, seed: int, out, *, progress: bool = False,
     records: list[dict[str, Any]] = []
     for exp in exps:
         rows = summarise(out / f"{exp.name}.sqlite", exp, include_volatile=True)
-        for r in report_records(rows, exp, ("n", "variant")):
+        for r in report_records(rows, exp, ("n", "variant", "features", "coverage")):
             r["method_is_ours"] = r["method"] not in PAPER_METHODS
             records.append(r)
     methods = sorted({r["method"] for r in records})
