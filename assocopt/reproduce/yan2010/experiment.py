@@ -160,6 +160,18 @@ def decision_options(setting: Mapping[str, Any], method: str) -> DecisionOptions
 REPORT_TIMES = (5, 10, 20, 40, 80)
 
 
+def _block(n1: int, n2: int, r: np.ndarray, c: np.ndarray, fill: float, compute,
+           lead: tuple[int, ...] = ()) -> np.ndarray:
+    """An ``lead + (n1, n2)`` matrix computed on rows ``r`` x columns ``c`` only (the
+    pairs some associator still tests), ``fill`` elsewhere (never read)."""
+    if len(r) == n1 and len(c) == n2:
+        return compute(slice(None), slice(None))
+    out = np.full(lead + (n1, n2), fill)
+    if len(r) and len(c):
+        out[..., r[:, None], c[None, :]] = compute(r, c)
+    return out
+
+
 def trial(setting: Mapping[str, Any], methods: Sequence[str],
           seed: np.random.SeedSequence) -> dict[str, dict[str, float]]:
     """One simulated run decided by every method, step by step (paired comparison).
@@ -192,8 +204,12 @@ def trial(setting: Mapping[str, Any], methods: Sequence[str],
         live = [m for m in methods if report[k] or not sparse or
                 METHODS[m]["counter"] != "off"]
         busy = [m for m in live if assoc[m].needs_input]
-        if busy:
-            D = statistical_distance(run.x[0][k], run.P[0][k], run.x[1][k], run.P[1][k])
+        if busy:                            # the distances of the pairs still open
+            r = np.flatnonzero(np.any([assoc[m].counter.open_rows for m in busy], axis=0))
+            c = np.flatnonzero(np.any([assoc[m].counter.open_cols for m in busy], axis=0))
+            f1, f2 = run.features[0][k], run.features[1][k]
+            D = _block(n1, n2, r, c, np.inf, lambda r, c: statistical_distance(
+                run.x[0][k][r], run.P[0][k][r], run.x[1][k][c], run.P[1][k][c]))
             F = {}                          # feature degrees, once per tolerance set
         for m in live:
             t0 = time.perf_counter()
@@ -201,9 +217,9 @@ def trial(setting: Mapping[str, Any], methods: Sequence[str],
                 a = assoc[m]
                 key = a.params.tolerances + a.params.weights
                 if key not in F:
-                    F[key] = pair_feature_degrees(run.features[0][k], run.features[1][k],
-                                                  a.params)
-                p = a.step(D, run.features[0][k], run.features[1][k], F[key])
+                    F[key] = _block(n1, n2, r, c, 0.0, lambda r, c, q=a.params:
+                                    pair_feature_degrees(f1[r], f2[c], q), lead=(3,))
+                p = a.step(D, f1, f2, F[key])
             else:                           # nothing open: the fixed pairs stand
                 fx = assoc[m].counter.fixed
                 p = np.where(fx >= 0, fx, -1)
