@@ -119,6 +119,7 @@ DEFAULTS: dict[str, Any] = {
     "grid_coverage": (0.0, 0.1, 0.2),      # single-node fractions of the grid
     "grid_features": ("types10", "per-emitter"),
     "grid_one_type_coverage": (0.0,),      # the "features matter" check: one type
+    "grid_runs": None,                     # runs of the grid and three nodes (None: runs)
     "fig4_n": 60,                          # Fig. 1's 60 targets
     "sensitivity_n": 100,
     "three_node_n": (10, 30, 60),
@@ -278,6 +279,7 @@ def experiments(runs: int, seed: int, options: Mapping[str, Any] | None = None,
     """The Experiments of the reproduction (``options`` override :data:`DEFAULTS`)."""
     o = _options(options)
     common = _common(o)
+    grid_runs = runs if o["grid_runs"] is None else int(o["grid_runs"])
     out = []
     if "table1" in parts:
         settings = [{"part": "table1", "n": n, **common} for n in TABLE1_N]
@@ -297,14 +299,14 @@ def experiments(runs: int, seed: int, options: Mapping[str, Any] | None = None,
             [("one-type", c) for c in o["grid_one_type_coverage"]]
         settings = [_grid_setting("grid", n, f, c, common) for n in o["grid_n"]
                     for f, c in cells]
-        out.append(Experiment("yan2010-grid", settings, GRID_METHODS, trial, runs, seed,
+        out.append(Experiment("yan2010-grid", settings, GRID_METHODS, trial, grid_runs, seed,
                               params={"experiment": "grid"}, volatile=VOLATILE))
     if "three_node" in parts:
         settings = [{**_grid_setting("three_node", n, f, c, common),
                      "times": list(o["three_node_times"])} for n in o["three_node_n"]
                     for f in o["three_node_features"] for c in o["three_node_coverage"]]
         out.append(Experiment("yan2010-three_node", settings, THREE_NODE_METHODS, trial,
-                              runs, seed, params={"experiment": "three_node"},
+                              grid_runs, seed, params={"experiment": "three_node"},
                               volatile=VOLATILE))
     return out
 
@@ -357,7 +359,7 @@ def parameters(options: Mapping[str, Any] | None = None) -> dict[str, Any]:
             "grid": {"n": list(o["grid_n"]), "coverage": list(o["grid_coverage"]),
                      "features": list(o["grid_features"]),
                      "one_type_coverage": list(o["grid_one_type_coverage"]),
-                     "methods": list(GRID_METHODS)},
+                     "methods": list(GRID_METHODS), "runs": o["grid_runs"]},
             "fig4_n": o["fig4_n"], "sensitivity_n": o["sensitivity_n"],
             "sensitivity_variants": SENS_VARIANTS,
             "three_node": {"n": list(o["three_node_n"]), "times": list(o["three_node_times"]),
