@@ -20,7 +20,8 @@ from __future__ import annotations
 from pathlib import Path
 from typing import Any, Mapping, Sequence
 
-from ...experiments import report_records, run_all, summarise
+from ...experiments import report_records, summarise
+from ..runlog import run_timed
 from .._report import write_report
 from .experiment import (DEFAULTS, LABELS, METHODS, PAPER_CLAIMS, PAPER_METHODS,  # noqa: F401
                          PAPER_TABLE1, SENS_VARIANTS, TABLE1_N, experiments, parameters, trial)
@@ -39,11 +40,13 @@ def run(runs: int, workers: int, seed: int, out, *, progress: bool = False,
 
     Writes ``out/summary.json``, ``out/tables.md``, PNG figures (when matplotlib is
     installed) and the stores ``out/yan2010-*.sqlite``; prints the tables with
-    ``echo``.  Returns the summary dict.
+    ``echo``.  ``summary.json`` keeps, under ``timing_history``, the wall time of every
+    invocation into ``out`` that computed trials.  Returns the summary dict.
     """
     out = Path(out)
     exps = experiments(runs, seed, options, parts)
-    timing = run_all(exps, out, workers=workers, executor=executor, progress=progress)
+    timed = run_timed(exps, out, runs=runs, workers=workers, seed=seed, options=options,
+                      executor=executor, progress=progress)
     records: list[dict[str, Any]] = []
     for exp in exps:
         rows = summarise(out / f"{exp.name}.sqlite", exp, include_volatile=True)
@@ -61,6 +64,6 @@ def run(runs: int, workers: int, seed: int, out, *, progress: bool = False,
         "paper_values": {"table1": list(PAPER_TABLE1), "table1_n": list(TABLE1_N),
                          "claims": PAPER_CLAIMS},
         "records": records,
-        "timing": timing,
+        **timed,
     }
     return write_report(out, summary, render_tables, make_figures, echo)

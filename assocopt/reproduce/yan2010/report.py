@@ -8,6 +8,7 @@ from __future__ import annotations
 from typing import Any, Mapping
 
 from .._plot import pyplot, save
+from ..runlog import timing_lines
 from .experiment import (FIG4_METHODS, LABELS, PAPER_TABLE1, SENS_METHODS, SENS_VARIANTS,
                          TABLE1_METHODS, TABLE1_N)
 from .report_grid import _grid, _variants, grid_tables, section, three_node_tables
@@ -59,6 +60,8 @@ def render_tables(summary: Mapping[str, Any]) -> str:
     lines += _sensitivity_table(recs)
     lines += grid_tables(summary)
     lines += three_node_tables(summary)
+    lines += timing_lines(summary, "yan2010", section(
+        "timing", "Runs that computed trials (wall time of each invocation)"))
     return "\n".join(lines)
 
 
