@@ -119,7 +119,8 @@ DEFAULTS: dict[str, Any] = {
     "grid_coverage": (0.0, 0.1, 0.2),      # single-node fractions of the grid
     "grid_features": ("types10", "per-emitter"),
     "grid_one_type_coverage": (0.0,),      # the "features matter" check: one type
-    "grid_runs": None,                     # runs of the grid and three nodes (None: runs)
+    "grid_runs": None,                     # runs of the parts that are ours: sensitivity,
+                                           # grid, three nodes (None: runs)
     "fig4_n": 60,                          # Fig. 1's 60 targets
     "sensitivity_n": 100,
     "three_node_n": (10, 30, 60),
@@ -292,7 +293,8 @@ def experiments(runs: int, seed: int, options: Mapping[str, Any] | None = None,
     if "sensitivity" in parts:
         settings = [{"part": "sensitivity", "n": int(o["sensitivity_n"]), "variant": v,
                      **{**common, **ov}} for v, ov in SENS_VARIANTS.items()]
-        out.append(Experiment("yan2010-sensitivity", settings, SENS_METHODS, trial, runs, seed,
+        out.append(Experiment("yan2010-sensitivity", settings, SENS_METHODS, trial, grid_runs,
+                              seed,
                               params={"experiment": "sensitivity"}, volatile=VOLATILE))
     if "grid" in parts:
         cells = [(f, c) for f in o["grid_features"] for c in o["grid_coverage"]] + \
