@@ -9,6 +9,7 @@ Four experiments, each with its own results store ``OUT/yan2010-*.sqlite``:
 ``sensitivity``  ours: 100 targets, one open parameter changed at a time.
 ``grid``         ours: 10..100 targets, single-node fraction x feature set, the paper's
                  rule against the 2-D assignment, counter or not, tolerance factor 2 or 1.
+``confirm``      ours: one grid cell (option ``confirm``) rerun on fresh seeds.
 ``three_node``   ours: a third TDOA system and one S-D assignment over the three.
 
 Every method of a trial decides on the same simulated run (paired comparison).  The
@@ -30,7 +31,7 @@ from .report import make_figures, render_tables  # noqa: F401
 __all__ = ["PAPER_TABLE1", "TABLE1_N", "DEFAULTS", "METHODS", "experiments", "trial",
            "parameters", "run", "render_tables", "make_figures"]
 
-PARTS = ("table1", "fig4", "sensitivity", "grid", "three_node")
+PARTS = ("table1", "fig4", "sensitivity", "grid", "confirm", "three_node")
 
 
 def run(runs: int, workers: int, seed: int, out, *, progress: bool = False,

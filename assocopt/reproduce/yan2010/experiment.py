@@ -119,6 +119,8 @@ DEFAULTS: dict[str, Any] = {
     "grid_coverage": (0.0, 0.1, 0.2),      # single-node fractions of the grid
     "grid_features": ("types10", "per-emitter"),
     "grid_one_type_coverage": (0.0,),      # the "features matter" check: one type
+    "confirm": None,                       # (features, coverage): a grid cell rerun on
+                                           # fresh seeds (part "confirm")
     "grid_runs": None,                     # runs of the parts that are ours: sensitivity,
                                            # grid, three nodes (None: runs)
     "fig4_n": 60,                          # Fig. 1's 60 targets
@@ -303,6 +305,11 @@ def experiments(runs: int, seed: int, options: Mapping[str, Any] | None = None,
                     for f, c in cells]
         out.append(Experiment("yan2010-grid", settings, GRID_METHODS, trial, grid_runs, seed,
                               params={"experiment": "grid"}, volatile=VOLATILE))
+    if "confirm" in parts and o["confirm"] is not None:
+        f, c = o["confirm"]                 # "part" differs from the grid's: fresh seeds
+        settings = [_grid_setting("confirm", n, f, c, common) for n in o["grid_n"]]
+        out.append(Experiment("yan2010-confirm", settings, GRID_METHODS, trial, grid_runs,
+                              seed, params={"experiment": "confirm"}, volatile=VOLATILE))
     if "three_node" in parts:
         settings = [{**_grid_setting("three_node", n, f, c, common),
                      "times": list(o["three_node_times"])} for n in o["three_node_n"]
@@ -323,7 +330,7 @@ def _grid_setting(part: str, n: int, features: str, coverage: float,
     if features not in FEATURE_SETS:
         raise ValueError(f"feature set must be one of {sorted(FEATURE_SETS)}, got {features!r}")
     return {"part": part, "n": int(n), "variant": variant_name(features, coverage),
-            "sparse": part == "grid",
+            "sparse": part in ("grid", "confirm"),
             "features": features, "coverage": float(coverage),
             **{**common, **FEATURE_SETS[features], "single_node_fraction": float(coverage)}}
 
@@ -362,6 +369,7 @@ def parameters(options: Mapping[str, Any] | None = None) -> dict[str, Any]:
                      "features": list(o["grid_features"]),
                      "one_type_coverage": list(o["grid_one_type_coverage"]),
                      "methods": list(GRID_METHODS), "runs": o["grid_runs"]},
+            "confirm": None if o["confirm"] is None else list(o["confirm"]),
             "fig4_n": o["fig4_n"], "sensitivity_n": o["sensitivity_n"],
             "sensitivity_variants": SENS_VARIANTS,
             "three_node": {"n": list(o["three_node_n"]), "times": list(o["three_node_times"]),

@@ -11,7 +11,8 @@ from .._plot import pyplot, save
 from ..runlog import timing_lines
 from .experiment import (FIG4_METHODS, LABELS, PAPER_TABLE1, SENS_METHODS, SENS_VARIANTS,
                          TABLE1_METHODS, TABLE1_N)
-from .report_grid import _grid, _variants, grid_tables, section, three_node_tables
+from .report_grid import (_grid, _variants, confirm_table, grid_tables, section,
+                          three_node_tables)
 
 __all__ = ["render_tables", "make_figures", "lookup", "FIG4_TIMES"]
 
@@ -59,6 +60,7 @@ def render_tables(summary: Mapping[str, Any]) -> str:
     lines += _fig4_table(recs)
     lines += _sensitivity_table(recs)
     lines += grid_tables(summary)
+    lines += confirm_table(summary)
     lines += three_node_tables(summary)
     lines += timing_lines(summary, "yan2010", section(
         "timing", "Runs that computed trials (wall time of each invocation)"))
