@@ -16,10 +16,10 @@ from pathlib import Path
 
 import pytest
 
-from assocopt.reproduce import lu2013, pages, zhang2009
+from assocopt.reproduce import lu2013, pages, yan2010, zhang2009
 
 DOCS = Path(__file__).resolve().parents[1] / "docs" / "papers"
-PAPERS = {"lu2013": lu2013, "zhang2009": zhang2009}
+PAPERS = {"lu2013": lu2013, "yan2010": yan2010, "zhang2009": zhang2009}
 
 
 def _load(name):

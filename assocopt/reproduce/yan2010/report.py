@@ -8,8 +8,11 @@ from __future__ import annotations
 from typing import Any, Mapping
 
 from .._plot import pyplot, save
+from ..runlog import timing_lines
 from .experiment import (FIG4_METHODS, LABELS, PAPER_TABLE1, SENS_METHODS, SENS_VARIANTS,
                          TABLE1_METHODS, TABLE1_N)
+from .report_grid import (_grid, _variants, confirm_table, grid_tables, section,
+                          three_node_tables)
 
 __all__ = ["render_tables", "make_figures", "lookup", "FIG4_TIMES"]
 
@@ -41,9 +44,9 @@ def render_tables(summary: Mapping[str, Any]) -> str:
     c80 = lookup(recs, "table1", "correct_80")
     if c80:
         runs = max(v[2] for v in c80.values())
-        lines += [f"### Table 1 — correct association probability at t = 80 s ({runs} runs "
-                  "per point; ours ± 95 % band)", "",
-                  "| targets | " + " | ".join(str(n) for n in TABLE1_N) + " |",
+        lines += section("table1", f"Table 1 — correct association probability at t = 80 s "
+                         f"({runs} runs per point; ours ± 95 % band; full coverage)")
+        lines += ["| targets | " + " | ".join(str(n) for n in TABLE1_N) + " |",
                   "|---" * (len(TABLE1_N) + 1) + "|",
                   "| paper | " + " | ".join(f"{v:.4f}" for v in PAPER_TABLE1) + " |"]
         for m in TABLE1_METHODS:
@@ -56,7 +59,11 @@ def render_tables(summary: Mapping[str, Any]) -> str:
         lines += _extras_table(recs)
     lines += _fig4_table(recs)
     lines += _sensitivity_table(recs)
-    lines += _three_node_table(recs)
+    lines += grid_tables(summary)
+    lines += confirm_table(summary)
+    lines += three_node_tables(summary)
+    lines += timing_lines(summary, "yan2010", section(
+        "timing", "Runs that computed trials (wall time of each invocation)"))
     return "\n".join(lines)
 
 
@@ -70,8 +77,8 @@ def _extras_table(recs) -> list[str]:
             ("fixed_final", "ds-max", "paper's rule: tracks fixed at 80 s / n"),
             ("correct_5", "ds-max", "paper's rule: correct rate at 5 s"),
             ("correct_5", "weighted", "weighted test: correct rate at 5 s")]
-    lines = ["### Table 1 settings — what else happens (means over runs)", "",
-             "| quantity | " + " | ".join(str(n) for n in TABLE1_N) + " |",
+    lines = section("table1-extras", "Table 1 settings — what else happens (means over runs)")
+    lines += ["| quantity | " + " | ".join(str(n) for n in TABLE1_N) + " |",
              "|---" * (len(TABLE1_N) + 1) + "|"]
     for metric, method, label in rows:
         tab = lookup(recs, "table1", metric)
@@ -88,8 +95,9 @@ def _fig4_table(recs) -> list[str]:
     if not times:
         return []
     (m0, n), v = next(iter(tabs[times[-1]].items()))
-    lines = [f"### Fig. 4 — correct rate over time, {n} targets ({v[2]} runs; ± 95 % band)",
-             "", "| method | " + " | ".join(f"t = {t} s" for t in times) + " |",
+    lines = section("fig4", f"Fig. 4 — correct rate over time, {n} targets ({v[2]} runs; "
+                    "± 95 % band)")
+    lines += ["| method | " + " | ".join(f"t = {t} s" for t in times) + " |",
              "|---" * (len(times) + 1) + "|"]
     for m in FIG4_METHODS:
         lines.append(f"| {m} | " + " | ".join(_cell(tabs[t].get((m, n))) for t in times)
@@ -105,37 +113,15 @@ def _sensitivity_table(recs) -> list[str]:
         return []
     runs = max(v[2] for v in c80.values())
     n = next(r["setting"]["n"] for r in recs if r["experiment"] == "sensitivity")
-    lines = [f"### Sensitivity (ours) — one open parameter changed at a time, {n} targets "
-             f"({runs} runs): correct rate at 80 s [at 5 s]", "",
-             "| variant | " + " | ".join(SENS_METHODS) + " | ds-max shared scans |",
+    lines = section("sensitivity", f"Sensitivity (ours) — one open parameter changed at a "
+                    f"time, {n} targets ({runs} runs): correct rate at 80 s [at 5 s]")
+    lines += ["| variant | " + " | ".join(SENS_METHODS) + " | ds-max shared scans |",
              "|---" * (len(SENS_METHODS) + 2) + "|"]
     for v in SENS_VARIANTS:
         cells = [f"{_cell(c80.get((m, v)), False)} [{_cell(c5.get((m, v)), False)}]"
                  for m in SENS_METHODS]
         lines.append(f"| {v} | " + " | ".join(cells) + f" | {_cell(sh.get(('ds-max', v)), False)} |")
     return lines + [""]
-
-
-def _three_node_table(recs) -> list[str]:
-    out = []
-    tabs = {}
-    for r in recs:
-        if r["experiment"] == "three_node" and r["metric"] != "t_decide":
-            tabs[(r["method"], r["metric"], r["setting"]["n"])] = (r["value"], Z95 * (r["stderr"] or 0))
-    if not tabs:
-        return out
-    ns = sorted({k[2] for k in tabs})
-    metrics = sorted({k[1] for k in tabs}, key=lambda s: (s.split("_")[0], int(s.split("_")[1])))
-    out += ["### Three nodes (ours): one S-D assignment against the 2-D assignment of "
-            "nodes 1-2, single scans, pair frame (± 95 % band)", "",
-            "| method | metric | " + " | ".join(f"n = {n}" for n in ns) + " |",
-            "|---|---" + "|---" * len(ns) + "|"]
-    for meth in ("sd-3", "pairwise-2d"):
-        for met in metrics:
-            if (meth, met, ns[0]) in tabs:
-                out.append(f"| {meth} | {met} | " + " | ".join(
-                    _cell(tabs.get((meth, met, n))) for n in ns) + " |")
-    return out + [""]
 
 
 def make_figures(summary: Mapping[str, Any], out) -> list[str]:
@@ -184,4 +170,26 @@ def make_figures(summary: Mapping[str, Any], out) -> list[str]:
         ax.grid(alpha=0.3)
         ax.legend(fontsize=7)
         made.append(save(fig, out, "table1_correct_rate.png"))
+    made += _grid_figure(plt, recs, out)
     return made
+
+
+def _grid_figure(plt, recs, out) -> list[str]:
+    """The paper's rule (all-track rate at 80 s, no counter and counter) against n for
+    every grid setting, with Table 1."""
+    tab = _grid(recs)
+    if not tab:
+        return []
+    fig, axes = plt.subplots(1, 2, figsize=(11, 4.2), sharey=True)
+    for ax, m, title in ((axes[0], "ds-max", "counter"), (axes[1], "ds-max-nocounter",
+                                                           "no counter")):
+        ax.plot(TABLE1_N, PAPER_TABLE1, "ko-", label="paper, Table 1", lw=2)
+        for v in _variants(recs):
+            ns = [n for n in TABLE1_N if (m, v, "all_80", n) in tab]
+            ax.plot(ns, [tab[(m, v, "all_80", n)][0] for n in ns], ".-", label=v, lw=1)
+        ax.set_title(f"paper's rule, {title}: all-track rate at 80 s")
+        ax.set_xlabel("number of targets")
+        ax.grid(alpha=0.3)
+    axes[0].set_ylabel("correct association rate")
+    axes[1].legend(fontsize=6, loc="lower left")
+    return [save(fig, out, "grid_rule_all80.png")]

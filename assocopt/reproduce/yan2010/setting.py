@@ -15,7 +15,8 @@ __all__ = ["SCENARIO_KEYS", "scenario_of", "degree_params"]
 
 #: Keys of a setting that configure the scenario (the rest configure the decision).
 SCENARIO_KEYS = ("tracker", "init", "q_true", "q_filter", "period", "duration", "freq_range",
-                  "pw_range", "pri_range", "emitter_types", "region_scale")
+                  "pw_range", "pri_range", "emitter_types", "region_scale",
+                  "single_node_fraction", "tdoa_sigma_scale")
 
 
 def scenario_of(setting: Mapping[str, Any], nodes: int = 2) -> Yan2010:
@@ -26,8 +27,10 @@ def scenario_of(setting: Mapping[str, Any], nodes: int = 2) -> Yan2010:
 
 
 def degree_params(setting: Mapping[str, Any], sc: Yan2010, fusion: str = "candidate",
-                  a: int = 0, b: int = 1) -> DegreeParams:
-    """Weights and tolerances of the degrees between nodes ``a`` and ``b``."""
+                  a: int = 0, b: int = 1, k_tol: float | None = None) -> DegreeParams:
+    """Weights and tolerances of the degrees between nodes ``a`` and ``b`` (tolerance
+    factor ``k_tol``, default the setting's)."""
     sig = sc.feature_sigmas()
-    tols = tuple(tolerance(sig[a, k], sig[b, k], float(setting["k_tol"])) for k in range(3))
+    k = float(setting["k_tol"] if k_tol is None else k_tol)
+    tols = tuple(tolerance(sig[a, i], sig[b, i], k) for i in range(3))
     return DegreeParams(weights=tuple(setting["weights"]), tolerances=tols, fusion=fusion)

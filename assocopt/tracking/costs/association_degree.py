@@ -34,7 +34,7 @@ from ..belief import conjunctive_vectors
 
 __all__ = ["FUSIONS", "DegreeParams", "statistical_distance", "state_degree",
            "feature_degree", "tolerance", "fuse_candidate_frame", "fuse_pair_frame",
-           "feature_degrees", "fused_degree"]
+           "pair_feature_degrees", "feature_degrees", "fused_degree"]
 
 #: Readings of "fuse the degrees with Dempster's rule" (module docstring).
 FUSIONS = ("candidate", "pair")
@@ -85,19 +85,57 @@ def tolerance(sigma1: float, sigma2: float, k_tol: float) -> float:
 
 def statistical_distance(x1: ArrayLike, p1: ArrayLike, x2: ArrayLike, p2: ArrayLike) -> np.ndarray:
     """Eq. (3) for every pair: ``(n1, nx)``, ``(n1, nx, nx)``, ``(n2, nx)``, ``(n2, nx, nx)``
-    -> ``(n1, n2)``, by one batched linear solve."""
+    -> ``(n1, n2)``.
+
+    ``P1_i + P2_j`` is factored ``L L^T`` (Cholesky) for all pairs at once, entry by
+    entry over ``(n1, n2)`` arrays (:func:`_spd_quadratic_form`), and ``D = |L^-1 d|^2``;
+    pairs whose sum is not positive definite fall back to ``np.linalg.solve``.
+    """
     x1, p1, x2, p2 = (np.asarray(a, dtype=np.float64) for a in (x1, p1, x2, p2))
     if x1.ndim != 2 or x2.ndim != 2 or x1.shape[1] != x2.shape[1] or \
             p1.shape != x1.shape + x1.shape[1:] or p2.shape != x2.shape + x2.shape[1:]:
         raise ValueError(f"shapes must be (n1, nx), (n1, nx, nx), (n2, nx), (n2, nx, nx); "
                          f"got {x1.shape}, {p1.shape}, {x2.shape}, {p2.shape}")
-    d = x1[:, None, :] - x2[None, :, :]
-    s = p1[:, None] + p2[None, :]
-    try:
-        y = np.linalg.solve(s, d[..., None])[..., 0]
-    except np.linalg.LinAlgError as exc:
-        raise ValueError("P1_i + P2_j is singular for some pair") from exc
-    return (d * y).sum(axis=-1)
+    out, ok = _spd_quadratic_form(x1, p1, x2, p2)
+    if not ok.all():
+        i, j = np.nonzero(~ok)
+        d = x1[i] - x2[j]
+        try:
+            y = np.linalg.solve(p1[i] + p2[j], d[..., None])[..., 0]
+        except np.linalg.LinAlgError as exc:
+            raise ValueError("P1_i + P2_j is singular for some pair") from exc
+        out[i, j] = (d * y).sum(axis=-1)
+    return out
+
+
+def _spd_quadratic_form(x1: np.ndarray, p1: np.ndarray, x2: np.ndarray, p2: np.ndarray
+                        ) -> tuple[np.ndarray, np.ndarray]:
+    """``d^T S^-1 d`` with ``d = x1_i - x2_j``, ``S = p1_i + p2_j`` for every pair, by an
+    elementwise Cholesky on ``(n1, n2)`` arrays (never forming the ``(n1, n2, nx, nx)``
+    stack); also the mask of pairs whose ``S`` is positive definite (elsewhere the
+    value is meaningless)."""
+    nx = x1.shape[1]
+    ok = np.ones((len(x1), len(x2)), dtype=bool)
+    L: list[list] = [[None] * nx for _ in range(nx)]
+    y: list[np.ndarray] = []                                  # forward solve L y = d
+    for i in range(nx):
+        for j in range(i + 1):
+            acc = p1[:, None, i, j] + p2[None, :, i, j]
+            for k in range(j):
+                acc -= L[i][k] * L[j][k]
+            if i == j:
+                ok &= acc > 0
+                L[i][i] = np.sqrt(np.where(acc > 0, acc, 1.0))
+            else:
+                L[i][j] = acc / L[j][j]
+        acc = x1[:, None, i] - x2[None, :, i]
+        for k in range(i):
+            acc -= L[i][k] * y[k]
+        y.append(acc / L[i][i])
+    out = y[0] * y[0]
+    for v in y[1:]:
+        out += v * v
+    return out, ok
 
 
 def state_degree(D: ArrayLike, weight: float, d_tiny: float = 1e-12,
@@ -127,19 +165,27 @@ def feature_degree(delta: ArrayLike, eps: float, weight: float) -> np.ndarray:
     return np.where(d <= eps, weight, np.where(d < 2.0 * eps, mid, 0.0))
 
 
+def pair_feature_degrees(f1: ArrayLike, f2: ArrayLike, params: DegreeParams) -> np.ndarray:
+    """The frequency (5), PW (6) and PRI (7) degrees of every pair, ``(3, n1, n2)``.
+
+    They do not depend on which tracks are still candidates, so a caller deciding
+    several ways on one scan computes them once (:meth:`TrackAssociator.step`).
+    """
+    f1 = np.asarray(f1, dtype=np.float64)
+    f2 = np.asarray(f2, dtype=np.float64)
+    a = params.weights
+    return np.stack([feature_degree(f1[:, None, k] - f2[None, :, k], params.tolerances[k],
+                                    a[k + 1]) for k in range(3)])
+
+
 def feature_degrees(D: ArrayLike, f1: ArrayLike, f2: ArrayLike, params: DegreeParams,
                     candidates: ArrayLike | None = None) -> np.ndarray:
     """The four degrees ``(4, n1, n2)``: state (4), frequency (5), PW (6), PRI (7).
 
     ``f1`` ``(n1, 3)`` and ``f2`` ``(n2, 3)`` hold frequency, PW and PRI per track.
     """
-    f1 = np.asarray(f1, dtype=np.float64)
-    f2 = np.asarray(f2, dtype=np.float64)
-    a = params.weights
-    out = [state_degree(D, a[0], params.d_tiny, candidates)]
-    for k in range(3):
-        out.append(feature_degree(f1[:, None, k] - f2[None, :, k], params.tolerances[k], a[k + 1]))
-    m = np.stack(out)
+    state = state_degree(D, params.weights[0], params.d_tiny, candidates)
+    m = np.concatenate([state[None], pair_feature_degrees(f1, f2, params)])
     if candidates is not None:
         m = m * np.broadcast_to(np.asarray(candidates, bool), m.shape[1:])
     return m

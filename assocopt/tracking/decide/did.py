@@ -225,7 +225,8 @@ def stage1_case(s_on: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     new = all_off.all(axis=1)
     unique = (all_on.sum(axis=1) == 1) & (all_on | all_off).all(axis=1)
     case = np.where(new, NEW, np.where(unique, UNIQUE, AMBIGUOUS))
-    k = np.where(unique, np.argmax(all_on, axis=1), -1)
+    first = np.argmax(all_on, axis=1) if all_on.shape[1] else np.zeros(len(case), np.int64)
+    k = np.where(unique, first, -1)                # no records: every report is NEW
     return case, k
 
 

@@ -39,7 +39,8 @@ from scipy.stats import chi2
 
 from ...solving.api import solve
 from ...problems.problem import AssignmentProblem
-from ..costs.association_degree import DegreeParams, feature_degrees, fused_degree
+from ..costs.association_degree import (DegreeParams, fused_degree, pair_feature_degrees,
+                                        state_degree)
 
 __all__ = ["RULES", "ASSIGNMENT_COSTS", "COUNTER_SEMANTICS", "DecisionOptions",
            "QualityCounter", "max_degree_rule", "assignment_rule", "weighted_rule",
@@ -214,8 +215,23 @@ class TrackAssociator:
         self.gate = float(chi2.ppf(1.0 - options.gate_alpha, n_x))
         self.last_open_partner = np.full(n1, -1)
 
-    def step(self, D: np.ndarray, f1: np.ndarray, f2: np.ndarray) -> np.ndarray:
+    @property
+    def needs_input(self) -> bool:
+        """Whether a step has anything to decide (an open row and an open column)."""
+        return bool(self.counter.open_rows.any() and self.counter.open_cols.any())
+
+    def step(self, D: np.ndarray, f1: np.ndarray, f2: np.ndarray,
+             feature_m: np.ndarray | None = None) -> np.ndarray:
+        """One scan; ``feature_m`` optionally gives :func:`pair_feature_degrees` of all
+        pairs (computed once when several associators decide the same scan)."""
         o, ctr = self.options, self.counter
+        n1, n2 = ctr.delta.shape
+        D, f1, f2 = np.asarray(D, float), np.asarray(f1, float), np.asarray(f2, float)
+        if D.shape != (n1, n2):
+            raise ValueError(f"D must have shape ({n1}, {n2}), got {D.shape}")
+        if f1.shape != (n1, 3) or f2.shape != (n2, 3):
+            raise ValueError(f"features must have shapes ({n1}, 3) and ({n2}, 3), got "
+                             f"{f1.shape} and {f2.shape}")
         rows, cols = np.flatnonzero(ctr.open_rows), np.flatnonzero(ctr.open_cols)
         sub = np.full(len(rows), -1)
         if len(rows) and len(cols):
@@ -223,12 +239,16 @@ class TrackAssociator:
             if o.rule == "weighted":
                 sub = weighted_rule(Dsub, self.gate)
             else:
-                m = fused_degree(feature_degrees(Dsub, f1[rows], f2[cols], self.params),
-                                 self.params.fusion)
+                F = (pair_feature_degrees(f1[rows], f2[cols], self.params)
+                     if feature_m is None else feature_m[:, rows][:, :, cols])
+                p = self.params
+                m = fused_degree(np.concatenate([state_degree(Dsub, p.weights[0], p.d_tiny)[None],
+                                                 F]), p.fusion)
                 sub = (max_degree_rule(m, o.eps) if o.rule == "max-degree" else
                        assignment_rule(m, o.eps, o.cost, o.solver))
         partner = np.full(D.shape[0], -1)
-        partner[rows] = np.where(sub >= 0, cols[np.maximum(sub, 0)], -1)
+        took = sub >= 0                      # no open column left: every open row gets -1
+        partner[rows[took]] = cols[sub[took]]
         self.last_open_partner = partner.copy()
         out = np.where(ctr.fixed >= 0, ctr.fixed, partner)
         ctr.update(partner)

@@ -20,8 +20,13 @@ an extended Kalman filter.  Everything else is ours (:data:`OURS`, the fields of
 * emitter parameters: a catalogue of ``emitter_types`` radar types with frequency,
   PW and PRI uniform in ``freq_range`` (MHz), ``pw_range`` and ``pri_range``
   (microseconds); each emitter carries a type drawn uniformly, so emitters of one type
-  share their nominal parameters (``emitter_types = 0``: every emitter its own draw);
-  measured afresh at every scan with the paper's RMS errors;
+  share their nominal parameters (``emitter_types = 0``: every emitter its own draw
+  from the bands, so with fixed bands the feature overlap grows with the number of
+  emitters); measured afresh at every scan with the paper's RMS errors;
+* coverage: ``single_node_fraction`` of the emitters (rounded) are seen by one node
+  only, that node drawn uniformly among the nodes; the others by every node (the
+  paper's "common observation area" holds the common ones);
+* ``tdoa_sigma_scale`` multiplies every system's TDOA RMS error (1 = the paper's);
 * trackers (``tracker``): ``"ekf"`` -- the paper's EKF on the three range differences;
   ``"kf-fix"`` -- a linear Kalman filter on the linear TDOA fixes with their
   covariances; both with the nearly-constant-velocity model of intensity ``q_filter``;
@@ -63,13 +68,15 @@ PAPER = {
 
 
 class Yan2010Run(NamedTuple):
-    """One simulated run: truth and both nodes' track outputs at every reported scan.
+    """One simulated run: truth and every node's track outputs at every reported scan.
 
-    ``times`` ``(K,)``; ``truth`` ``(K, N, 4)``; ``x[n]`` ``(K, N, 4)`` and ``P[n]``
-    ``(K, N, 4, 4)`` node ``n``'s track estimates; ``features[n]`` ``(K, N, 3)``
-    (frequency MHz, PW us, PRI us) as measured at each scan; ``partner[i]`` = node-2
-    track of the emitter of node-1 track ``i`` (node-1 track ``i`` is emitter ``i``);
-    ``partners[n]`` the same for every node (``partners[0]`` is the identity).
+    ``times`` ``(K,)``; ``truth`` ``(K, N, 4)``; ``x[n]`` ``(K, n_n, 4)`` and ``P[n]``
+    ``(K, n_n, 4, 4)`` node ``n``'s track estimates (``n_n`` tracks: the emitters it
+    sees); ``features[n]`` ``(K, n_n, 3)`` (frequency MHz, PW us, PRI us) as measured
+    at each scan; ``emitter_of[n][j]`` the emitter of node ``n``'s track ``j`` (node 1
+    in emitter order, the other nodes shuffled); ``partners[n][i]`` the node-``n`` track
+    of the emitter of node-1 track ``i``, ``-1`` when node ``n`` does not see it
+    (``partners[0]`` is the identity); ``partner = partners[1]``.
     """
 
     times: np.ndarray
@@ -79,6 +86,13 @@ class Yan2010Run(NamedTuple):
     features: tuple[np.ndarray, ...]
     partner: np.ndarray
     partners: tuple[np.ndarray, ...]
+    emitter_of: tuple[np.ndarray, ...]
+
+    def partners_between(self, a: int, b: int) -> np.ndarray:
+        """Node-``b`` track of the emitter of each node-``a`` track, ``-1`` for none."""
+        where = np.full(self.truth.shape[1], -1)
+        where[self.emitter_of[b]] = np.arange(len(self.emitter_of[b]))
+        return where[self.emitter_of[a]]
 
 
 @dataclass(frozen=True)
@@ -95,13 +109,15 @@ class Yan2010:
     turn_start: tuple[float, float] = (10.0, 60.0)
     turn_duration: tuple[float, float] = (5.0, 20.0)
     turn_accel: tuple[float, float] = (2.0, 20.0)
-    freq_range: tuple[float, float] = (9000.0, 9400.0)
-    pw_range: tuple[float, float] = (0.5, 1.5)
-    pri_range: tuple[float, float] = (900.0, 1100.0)
+    freq_range: tuple[float, float] = (9000.0, 9100.0)
+    pw_range: tuple[float, float] = (0.8, 1.2)
+    pri_range: tuple[float, float] = (950.0, 1050.0)
     emitter_types: int = 10
     region_scale: float = 1.0
     baseline_angles_deg: tuple[float, float, float] = (90.0, 210.0, 330.0)
     nodes: int = 2
+    single_node_fraction: float = 0.0
+    tdoa_sigma_scale: float = 1.0
 
     def __post_init__(self) -> None:
         if not (isinstance(self.n_targets, int) and self.n_targets >= 1):
@@ -119,6 +135,11 @@ class Yan2010:
             raise ValueError(f"emitter_types must be an integer >= 0, got {self.emitter_types!r}")
         if self.nodes not in (2, 3):
             raise ValueError(f"nodes must be 2 or 3, got {self.nodes!r}")
+        if not 0.0 <= self.single_node_fraction <= 1.0:
+            raise ValueError(f"single_node_fraction must be in [0, 1], got "
+                             f"{self.single_node_fraction!r}")
+        if not self.tdoa_sigma_scale > 0:
+            raise ValueError(f"tdoa_sigma_scale must be > 0, got {self.tdoa_sigma_scale!r}")
         for name in ("freq_range", "pw_range", "pri_range", "turn_start", "turn_duration",
                      "turn_accel"):
             lo, hi = getattr(self, name)
@@ -133,10 +154,11 @@ class Yan2010:
         """The TDOA systems: the paper's two, and (``nodes=3``, ours) a third at (0, 100 km)
         with 28 km baselines."""
         mains, Ls, sig = PAPER["main_stations_m"], PAPER["baselines_m"], PAPER["tdoa_sigma_s"]
-        out = [TdoaSystem(tuple(mains[n]), Ls[n], sig[n], self.baseline_angles_deg)
+        k = self.tdoa_sigma_scale
+        out = [TdoaSystem(tuple(mains[n]), Ls[n], k * sig[n], self.baseline_angles_deg)
                for n in range(2)]
         if self.nodes == 3:
-            out.append(TdoaSystem((0.0, 100e3), 28e3, 30e-9, self.baseline_angles_deg))
+            out.append(TdoaSystem((0.0, 100e3), 28e3, k * 30e-9, self.baseline_angles_deg))
         return out
 
     def feature_sigmas(self) -> np.ndarray:
@@ -213,8 +235,24 @@ class Yan2010:
             Ps.append(P)
         return np.stack(xs), np.stack(Ps)
 
+    def coverage(self, rng: np.random.Generator) -> np.ndarray:
+        """``(nodes, N)`` bool: which node sees which emitter (``single_node_fraction``
+        of them, rounded, by one node only, drawn uniformly; no draw when it is 0)."""
+        N = self.n_targets
+        seen = np.ones((self.nodes, N), dtype=bool)
+        k = int(round(self.single_node_fraction * N))
+        if k:
+            only = rng.choice(N, size=k, replace=False)
+            seen[:, only] = False
+            seen[rng.integers(self.nodes, size=k), only] = True
+        return seen
+
     def simulate(self, rng: np.random.Generator) -> Yan2010Run:
-        """Truth, both (or three) nodes' tracks and measured features; seeded by ``rng``."""
+        """Truth, both (or three) nodes' tracks and measured features; seeded by ``rng``.
+
+        With ``single_node_fraction = 0`` the draws are those of the full-coverage
+        scenario (the coverage draw comes last and draws nothing then).
+        """
         truth = self.trajectories(rng)
         N = self.n_targets
         emit = self.emitters(rng)
@@ -225,14 +263,20 @@ class Yan2010:
         for n, system in enumerate(self.systems()):
             x, P = self.track(system, truth, rng)
             f = emit[None] + rng.normal(size=(K, N, 3)) * sig[n]
-            p = perms[n]                         # node n's track j is emitter p[j]
-            xs.append(x[:, p])
-            Ps.append(P[:, p])
-            feats.append(f[:, p])
-        partners = tuple(np.argsort(p) for p in perms)
+            xs.append(x)
+            Ps.append(P)
+            feats.append(f)
+        seen = self.coverage(rng)
+        emitter_of = tuple(p[seen[n][p]] for n, p in enumerate(perms))   # node n's track j
+        where = np.full((self.nodes, N), -1)
+        for n, e in enumerate(emitter_of):
+            where[n, e] = np.arange(len(e))
+        partners = tuple(where[n][emitter_of[0]] for n in range(self.nodes))
         times = self.period * np.arange(1, K + 1)
-        return Yan2010Run(times, truth[1:], tuple(xs), tuple(Ps), tuple(feats), partners[1],
-                          partners)
+        return Yan2010Run(times, truth[1:], tuple(x[:, e] for x, e in zip(xs, emitter_of)),
+                          tuple(P[:, e] for P, e in zip(Ps, emitter_of)),
+                          tuple(f[:, e] for f, e in zip(feats, emitter_of)), partners[1],
+                          partners, emitter_of)
 
 
 #: Names of the parameters that are ours (every field of :class:`Yan2010`).
