@@ -120,7 +120,11 @@ OPTIONS = [{}, {"degree": "objective"}, {"ref_cov": True, "frame": "full"},
            {"ref_cov": True, "inflate": True}, {"assignment": "rectangular"},
            {"frame": "full"}, {"inflate": True},
            {"metric": "euclidean"}, {"threshold": "heading", "coef": 50.0},
-           {"min_pairs": 3}, {"assignment": "rectangular", "metric": "euclidean"}]
+           {"min_pairs": 3}, {"assignment": "rectangular", "metric": "euclidean"},
+           {"assignment": "rectangular", "self_pair": "exclude"},
+           {"assignment": "rectangular", "ref_cov": True, "inflate": True,
+            "degree": "objective"},
+           {"self_pair": "exclude"}, {"frame": "full", "self_pair": "include"}]
 
 
 def _option_id(kw) -> str:

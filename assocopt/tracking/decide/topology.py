@@ -19,16 +19,25 @@ Options (:class:`TopologyParams`; every reading not fixed by the paper is named)
 ``metric``      ``"statistical"`` (gamma, the paper's) or ``"euclidean"`` (squared
                 distance of the positions, the Euclidean baseline);
 ``frame``       ``"position"`` (positions translated, velocities rotated) or ``"full"``
-                (whole state subtracted; the reference pair is then left out of
-                lambda, since it is the zero vector on both sensors);
+                (whole state subtracted: the reference is then the zero vector on
+                both sensors);
+``self_pair``   ``"include"`` (the reference pair (u, v) itself counts among the
+                confirmed pairs of lambda, as the paper converts "the data of target u
+                itself" too) or ``"exclude"`` (only the *neighbour* pairs count, as the
+                abstract's wording has it); it stays in the assignment either way.
+                Default (``None``): ``"exclude"`` with the full-state frame (where it
+                would always confirm itself at gamma = 0), ``"include"`` otherwise;
 ``assignment``  ``"dummy"`` (default: a dummy per row and column at half the gate,
                 so a pair is used only when it beats leaving both tracks out; solved
                 over the gated entries only, which is exact and fast) or
-                ``"rectangular"`` (the smaller side fully assigned, then gated; every
-                pair needs a full n x n Hungarian, about 15x slower at 30 targets);
-``inflate``     add the reference headings' variance to B (ours);
+                ``"rectangular"`` (the paper's order: the smaller side fully assigned,
+                then gated; exact, with distances computed lazily, see
+                :func:`~assocopt.tracking.decide._topology_kernel.phi_kernel`);
+``inflate``     add the reference headings' variance to B (ours: a substitute for the
+                paper's heading-adjusted threshold T_1, whose formula is lost);
 ``ref_cov``     first-order covariance of the offsets from the reference: adds the
-                reference's own position covariance (ours; the paper rotates P_i only);
+                reference's own position covariance (ours: a modelling improvement;
+                the paper rotates P_i only);
 ``degree``      ``"mean"`` (the paper's lambda: mean gamma over the confirmed pairs) or
                 ``"objective"`` (ours: the assignment cost per track with every
                 unconfirmed track at the gate, so a pair confirming few neighbours can
@@ -65,6 +74,7 @@ class TopologyParams:
     metric: str = "statistical"
     frame: str = "position"
     assignment: str = "dummy"
+    self_pair: str | None = None
     inflate: bool = False
     ref_cov: bool = False
     degree: str = "mean"
@@ -79,7 +89,8 @@ class TopologyParams:
                             ("frame", ("position", "full")),
                             ("assignment", ("rectangular", "dummy")),
                             ("threshold", ("chi2", "heading")),
-                            ("degree", ("mean", "objective"))):
+                            ("degree", ("mean", "objective")),
+                            ("self_pair", (None, "include", "exclude"))):
             if getattr(self, name) not in valid:
                 raise ValueError(f"{name} must be one of {valid}, got {getattr(self, name)!r}")
         if self.coef < 0 or self.euclid_gate_m <= 0:
@@ -87,6 +98,9 @@ class TopologyParams:
         if not isinstance(self.min_pairs, int) or self.min_pairs < 1:
             raise ValueError(f"min_pairs must be a positive integer, got {self.min_pairs!r}")
         chi2_gate(self.alpha, 4)
+        if self.self_pair is None:
+            object.__setattr__(self, "self_pair",
+                               "exclude" if self.frame == "full" else "include")
 
     def base_gate(self) -> float:
         """delta(alpha, 4) for the statistical distance, the squared gate in m^2 for the
@@ -148,7 +162,7 @@ def phi_matrix(inp: StepInputs, params: TopologyParams,
     v2 = np.where(np.isfinite(inp.var2), inp.var2, 1e6)
     return phi_kernel(inp.X1r, inp.P1r, inp.X2r, inp.P2r, inp.J1, v1, inp.J2, v2,
                       params.inflate, params.metric == "euclidean", thresholds(inp, params),
-                      params.assignment == "dummy", params.frame == "full",
+                      params.assignment == "dummy", params.self_pair == "exclude",
                       params.min_pairs, act, LARGE, params.degree == "objective")
 
 
@@ -186,13 +200,13 @@ def phi_reference(inp: StepInputs, params: TopologyParams, solver: str = "auto",
                 prob = AssignmentProblem.dense(G)
             rows, cols = solve(prob, solver).assignment()
             ok = G[rows, cols] <= t
-            if params.frame == "full":
+            if params.self_pair == "exclude":
                 ok &= ~((rows == u) & (cols == v))
             M[u, v] = int(ok.sum())
             if M[u, v] >= params.min_pairs:
                 phi[u, v] = float(G[rows, cols][ok].mean())
                 if params.degree == "objective":
-                    nn = min(n1, n2) - (params.frame == "full")
+                    nn = min(n1, n2) - (params.self_pair == "exclude")
                     phi[u, v] = (float(G[rows, cols][ok].sum()) + (nn - M[u, v]) * t) / nn
     return phi, M
 
