@@ -146,22 +146,87 @@ def _gated_matching(G, t, rows, cols, A):
 
 
 @njit(cache=True)
+def _pair_assignment(X1r, P1r, X2r, P2r, J1, var1, J2, var2, u, v, inflate, euclid, t,
+                     dummy, exclude_ref, G, A, rows, cols, col):
+    """The assignment of one reference pair (u, v) into ``col`` (``-1``: none), with
+    ``G`` exact wherever ``G <= t``; False (``col`` untouched) when no entry is under
+    the gate ``t`` (other than (u, v) when ``exclude_ref``), so nothing can be
+    confirmed whatever the assignment -- told by the position-block lower bounds alone.
+
+    ``dummy`` False: the rectangular assignment (the smaller side assigned completely,
+    the matrix padded with zero rows or columns, every distance exact); True: a dummy
+    per row and column at half the gate, solved over the gated entries only."""
+    n1 = X1r.shape[1]
+    n2 = X2r.shape[1]
+    n = A.shape[0]
+    pair_matrix(X1r, P1r, X2r, P2r, J1, var1, J2, var2, u, v, inflate, euclid, G, t)
+    under = 0
+    for i in range(n1):
+        for j in range(n2):
+            if G[i, j] <= t and not (exclude_ref and i == u and j == v):
+                under += 1
+    if under == 0:
+        return False
+    if dummy:
+        c = _gated_matching(G, t, rows, cols, A)
+        for i in range(n1):
+            col[i] = c[i]
+        return True
+    pair_matrix(X1r, P1r, X2r, P2r, J1, var1, J2, var2, u, v, inflate, euclid, G, INF)
+    for i in range(n):
+        for j in range(n):
+            A[i, j] = min(G[i, j], 1e300) if (i < n1 and j < n2) else 0.0
+    _, c, _, _, _ = hungarian(A)
+    for i in range(n1):
+        col[i] = c[i] if c[i] < n2 else -1
+    return True
+
+
+@njit(cache=True)
+def assign_kernel(X1r, P1r, X2r, P2r, J1, var1, J2, var2, inflate, euclid, thr, dummy,
+                  active):
+    """Every reference pair's assignment: ``(cols, gam)`` with ``cols[u, v, i]`` the
+    sensor-2 track assigned to neighbour i under (u, v) (``-1``: none, or the pair
+    not solved because nothing is under its gate or it is not ``active``) and
+    ``gam[u, v, i]`` its distance (``inf`` where ``cols`` is ``-1``)."""
+    n1 = X1r.shape[1]
+    n2 = X2r.shape[1]
+    n = max(n1, n2)
+    out = np.full((n1, n2, n1), -1, np.int64)
+    gam = np.full((n1, n2, n1), INF)
+    G = np.empty((n1, n2))
+    A = np.zeros((n, n))
+    rows = np.empty(n1, np.int64)
+    cols = np.empty(n2, np.int64)
+    col = np.empty(n1, np.int64)
+    for u in range(n1):
+        for v in range(n2):
+            if not active[u, v]:
+                continue
+            if not _pair_assignment(X1r, P1r, X2r, P2r, J1, var1, J2, var2, u, v,
+                                    inflate, euclid, thr[u, v], dummy, False, G, A,
+                                    rows, cols, col):
+                continue
+            for i in range(n1):
+                j = col[i]
+                if j >= 0:
+                    out[u, v, i] = j
+                    gam[u, v, i] = G[i, j]
+    return out, gam
+
+
+@njit(cache=True)
 def phi_kernel(X1r, P1r, X2r, P2r, J1, var1, J2, var2, inflate, euclid, thr, dummy,
                exclude_ref, min_pairs, active, large, objective):
     """``(phi, M)``: lambda_uv and the number of confirmed pairs for every (u, v).
 
-    Per pair: the rectangular assignment (``dummy`` False: the smaller side assigned
-    completely, the matrix padded with zero rows or columns, every distance exact),
-    or the assignment with a dummy per row and column at half the gate (``dummy``
-    True), solved over the gated entries only; then the assigned pairs with
-    ``gamma <= t`` are confirmed (the pair (u, v) itself not, when ``exclude_ref``).
-    A pair with no entry under the gate (other than (u, v) when it is excluded)
-    confirms nothing whatever the assignment, and is not solved (told by the
-    position-block lower bounds alone: exact distances are computed only where needed).  Pairs with
-    ``active`` False are skipped (``large``, 0).  ``objective``: lambda is the
-    assignment's cost per track with every unconfirmed track at the gate,
-    ``(sum of confirmed gamma + (N - M) t) / N``, ``N = min(n1, n2)`` (less the
-    reference pair when it is left out), instead of the mean over the confirmed pairs.
+    Per pair the assignment of :func:`_pair_assignment` (rectangular, or with dummies
+    at half the gate); then the assigned pairs with ``gamma <= t`` are confirmed (the
+    pair (u, v) itself not, when ``exclude_ref``).  Pairs with ``active`` False are
+    skipped (``large``, 0).  ``objective``: lambda is the assignment's cost per track
+    with every unconfirmed track at the gate, ``(sum of confirmed gamma + (N - M) t) /
+    N``, ``N = min(n1, n2)`` (less the reference pair when it is left out), instead of
+    the mean over the confirmed pairs.
     """
     n1 = X1r.shape[1]
     n2 = X2r.shape[1]
@@ -178,25 +243,10 @@ def phi_kernel(X1r, P1r, X2r, P2r, J1, var1, J2, var2, inflate, euclid, thr, dum
             if not active[u, v]:
                 continue
             t = thr[u, v]
-            pair_matrix(X1r, P1r, X2r, P2r, J1, var1, J2, var2, u, v, inflate, euclid, G, t)
-            under = 0
-            for i in range(n1):
-                for j in range(n2):
-                    if G[i, j] <= t and not (exclude_ref and i == u and j == v):
-                        under += 1
-            if under == 0:
+            if not _pair_assignment(X1r, P1r, X2r, P2r, J1, var1, J2, var2, u, v,
+                                    inflate, euclid, t, dummy, exclude_ref, G, A, rows,
+                                    cols, col):
                 continue
-            if dummy:
-                col = _gated_matching(G, t, rows, cols, A)
-            else:
-                pair_matrix(X1r, P1r, X2r, P2r, J1, var1, J2, var2, u, v, inflate, euclid,
-                            G, INF)
-                for i in range(n):
-                    for j in range(n):
-                        A[i, j] = min(G[i, j], 1e300) if (i < n1 and j < n2) else 0.0
-                _, c, _, _, _ = hungarian(A)
-                for i in range(n1):
-                    col[i] = c[i] if c[i] < n2 else -1
             s = 0.0
             m = 0
             for i in range(n1):

@@ -60,7 +60,7 @@ from ..topology import (check_tracks, chi2_gate, heading_jacobians, heading_vari
                         pair_distances, reference_frames)
 
 __all__ = ["TopologyParams", "StepInputs", "prepare", "thresholds", "pair_gammas",
-           "phi_matrix", "phi_reference",
+           "phi_matrix", "phi_reference", "assign_pairs", "degree_matrix",
            "coarse_pregate", "trial_pairs", "LARGE"]
 
 #: "A sufficiently large value" of lambda_uv when (u, v) has no confirmed pair.
@@ -147,6 +147,18 @@ def thresholds(inp: StepInputs, params: TopologyParams) -> np.ndarray:
     return g * (1.0 + params.coef * v)
 
 
+def _kernel_args(inp: StepInputs, params: TopologyParams, active):
+    n1, n2 = inp.X1r.shape[1], inp.X2r.shape[1]
+    act = np.ones((n1, n2), bool) if active is None else np.asarray(active, bool)
+    if act.shape != (n1, n2):
+        raise ValueError(f"active must have shape {(n1, n2)}, got {act.shape}")
+    v1 = np.where(np.isfinite(inp.var1), inp.var1, 1e6)
+    v2 = np.where(np.isfinite(inp.var2), inp.var2, 1e6)
+    return (inp.X1r, inp.P1r, inp.X2r, inp.P2r, inp.J1, v1, inp.J2, v2, params.inflate,
+            params.metric == "euclidean", thresholds(inp, params),
+            params.assignment == "dummy"), act
+
+
 def phi_matrix(inp: StepInputs, params: TopologyParams,
                active: np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray]:
     """``(Phi, M)``: lambda_uv and the confirmed-pair count of every reference pair
@@ -155,15 +167,47 @@ def phi_matrix(inp: StepInputs, params: TopologyParams,
     n1, n2 = inp.X1r.shape[1], inp.X2r.shape[1]
     if n1 == 0 or n2 == 0:
         return np.full((n1, n2), LARGE), np.zeros((n1, n2), np.int64)
-    act = np.ones((n1, n2), bool) if active is None else np.asarray(active, bool)
-    if act.shape != (n1, n2):
-        raise ValueError(f"active must have shape {(n1, n2)}, got {act.shape}")
-    v1 = np.where(np.isfinite(inp.var1), inp.var1, 1e6)
-    v2 = np.where(np.isfinite(inp.var2), inp.var2, 1e6)
-    return phi_kernel(inp.X1r, inp.P1r, inp.X2r, inp.P2r, inp.J1, v1, inp.J2, v2,
-                      params.inflate, params.metric == "euclidean", thresholds(inp, params),
-                      params.assignment == "dummy", params.self_pair == "exclude",
-                      params.min_pairs, act, LARGE, params.degree == "objective")
+    args, act = _kernel_args(inp, params, active)
+    return phi_kernel(*args, params.self_pair == "exclude", params.min_pairs, act, LARGE,
+                      params.degree == "objective")
+
+
+def assign_pairs(inp: StepInputs, params: TopologyParams,
+                 active: np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray]:
+    """Every reference pair's assignment, before any degree is formed: ``(cols,
+    gam)``, ``cols[u, v, i]`` the sensor-2 track assigned to neighbour i under (u, v)
+    (``-1``: none, or nothing under the gate) and ``gam[u, v, i]`` its distance.
+    :func:`degree_matrix` turns them into Phi for any ``self_pair``, ``degree`` and
+    ``min_pairs`` (which do not change the assignment), so several readings can share
+    one solve; ``degree_matrix(*assign_pairs(inp, p), thresholds(inp, p), p)`` equals
+    ``phi_matrix(inp, p)``."""
+    from ._topology_kernel import assign_kernel
+    n1, n2 = inp.X1r.shape[1], inp.X2r.shape[1]
+    if n1 == 0 or n2 == 0:
+        return np.full((n1, n2, n1), -1, np.int64), np.full((n1, n2, n1), np.inf)
+    args, act = _kernel_args(inp, params, active)
+    return assign_kernel(*args, act)
+
+
+def degree_matrix(cols: np.ndarray, gam: np.ndarray, thr: np.ndarray,
+                  params: TopologyParams) -> tuple[np.ndarray, np.ndarray]:
+    """``(Phi, M)`` from :func:`assign_pairs`' output and the gates ``thr``."""
+    n1, n2 = thr.shape
+    ok = (cols >= 0) & (gam <= thr[:, :, None])
+    if params.self_pair == "exclude" and n1 and n2:
+        u = np.arange(n1)[:, None]
+        ok[u, np.arange(n2)[None, :], u] &= cols[u, np.arange(n2)[None, :], u] != \
+            np.arange(n2)[None, :]
+    M = ok.sum(-1)
+    s = np.where(ok, gam, 0.0).sum(-1)
+    phi = np.full((n1, n2), LARGE)
+    real = (M > 0) & (M >= params.min_pairs)
+    if params.degree == "objective":
+        nn = min(n1, n2) - (params.self_pair == "exclude")
+        phi[real] = (s[real] + (nn - M[real]) * thr[real]) / nn
+    else:
+        phi[real] = s[real] / M[real]
+    return phi, M.astype(np.int64)
 
 
 def pair_gammas(inp: StepInputs, params: TopologyParams, u: int, v: int) -> np.ndarray:

@@ -61,14 +61,16 @@ from __future__ import annotations
 
 import math
 import time
+from dataclasses import replace
 from typing import Any, Mapping
 
 import numpy as np
 
 from ..decide.double_threshold import DoubleThreshold, IRRule
 from ..decide.nearest import gnn_assign, nearest_neighbour
-from ..decide.topology import (StepInputs, TopologyParams, coarse_pregate, phi_matrix,
-                               prepare, trial_pairs)
+from ..decide.topology import (StepInputs, TopologyParams, assign_pairs, coarse_pregate,
+                               degree_matrix, phi_matrix, prepare, thresholds,
+                               trial_pairs)
 from ..topology import chi2_gate, headings
 from .dong2015 import Run
 
@@ -136,9 +138,15 @@ def _params(opts: Mapping[str, Any], setting: Mapping[str, Any]) -> TopologyPara
                           euclid_gate_m=float(setting.get("euclid_gate_m", 1000.0)), **kw)
 
 
-def run_method(run: Run, method: str, setting: Mapping[str, Any] | None = None
-               ) -> dict[str, float]:
-    """Associate every step of ``run`` with ``method``; the metrics of the run."""
+def run_method(run: Run, method: str, setting: Mapping[str, Any] | None = None,
+               cache: dict | None = None) -> dict[str, float]:
+    """Associate every step of ``run`` with ``method``; the metrics of the run.
+
+    ``cache`` (a dict kept for one run): methods that differ only in ``self_pair``,
+    ``degree`` or ``min_pairs`` share each step's assignments
+    (:func:`~assocopt.tracking.decide.topology.assign_pairs`); the time of the shared
+    solve is counted in every such method's ``t_step_ms``, as if it ran alone.
+    """
     if method not in METHODS:
         raise ValueError(f"unknown dong2015 method {method!r}; valid: {sorted(METHODS)}")
     setting = dict(setting or {})
@@ -170,8 +178,12 @@ def run_method(run: Run, method: str, setting: Mapping[str, Any] | None = None
                 evaluated += int(active.sum())
             else:
                 evaluated += n1 * n2
-            inp = prepare(st.X1, st.P1, st.X2, st.P2, p)
-            phi, _ = phi_matrix(inp, p, active)
+            if cache is None:
+                inp = prepare(st.X1, st.P1, st.X2, st.P2, p)
+                phi, _ = phi_matrix(inp, p, active)
+            else:
+                inp, phi, shared = _shared_phi(cache, k, st, p, active)
+                t0 -= shared
             trial = trial_pairs(phi, opts.get("trial", "row"))
             partner = dt.update(trial, phi)
         t_total += time.perf_counter() - t0
@@ -190,6 +202,25 @@ def run_method(run: Run, method: str, setting: Mapping[str, Any] | None = None
     if method == "tsd":
         out.update(heading_errors(run))
     return out
+
+
+def _shared_phi(cache: dict, k: int, st, p: TopologyParams, active
+                ) -> tuple[StepInputs, np.ndarray, float]:
+    """Phi of step ``k`` from the cached assignments of every method with the same
+    assignment options; returns ``(inputs, Phi, seconds of the shared solve)`` (0 when
+    computed now: the caller's clock already runs)."""
+    key = (k, replace(p, self_pair="include", degree="mean", min_pairs=1),
+           None if active is None else active.tobytes())
+    took = 0.0
+    if key not in cache:
+        t0 = time.perf_counter()
+        inp = prepare(st.X1, st.P1, st.X2, st.P2, p)
+        cache[key] = (inp, *assign_pairs(inp, p, active), thresholds(inp, p))
+        cache[key + ("s",)] = time.perf_counter() - t0
+    else:
+        took = cache[key + ("s",)]
+    inp, cols, gam, thr = cache[key]
+    return inp, degree_matrix(cols, gam, thr, p)[0], took
 
 
 def calibration(inp: StepInputs, p: TopologyParams, truth: np.ndarray, gate: float
