@@ -165,8 +165,8 @@ def _coef_table(recs) -> list[str]:
     tabs = {k: lookup(recs, "coef", f"ec_k{k:02d}") for k in ks}
     runs = max(v[1] for v in tabs[ks[0]].values())
     coefs = sorted({key[2] for key in tabs[ks[0]]})
-    L = [f"### Threshold coefficient (Figs. 3-4; our substitute for T_1), environment 2: "
-         f"E_c per step ({runs} runs per point)", "",
+    L = [f"### Threshold coefficient (Figs. 3-4; our substitute for T_1, on the dummy "
+         f"reading), environment 2: E_c per step ({runs} runs per point)", "",
          "| method | coefficient | " + " | ".join(f"k={k}" for k in ks) + " |",
          "|---|---|" + "---|" * len(ks)]
     for m in _methods(tabs[ks[0]]):
