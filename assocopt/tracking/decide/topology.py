@@ -74,7 +74,6 @@ class TopologyParams:
     metric: str = "statistical"
     frame: str = "position"
     assignment: str = "dummy"
-    self_pair: str | None = None
     inflate: bool = False
     ref_cov: bool = False
     degree: str = "mean"
@@ -83,6 +82,7 @@ class TopologyParams:
     alpha: float = 0.01
     euclid_gate_m: float = 1000.0
     min_pairs: int = 1
+    self_pair: str | None = None        # last: positional construction keeps working
 
     def __post_init__(self) -> None:
         for name, valid in (("metric", ("statistical", "euclidean")),
