@@ -4,6 +4,7 @@ options are checked, and the page shows exactly what the committed summary gives
 from __future__ import annotations
 
 import json
+import re
 from pathlib import Path
 
 import pytest
@@ -13,7 +14,8 @@ from conftest import check_page_against_summary
 ROOT = Path(__file__).resolve().parents[1]
 SMALL = {"n_targets": 10, "missed": 2, "false_tracks": 2, "n_steps": 3,
          "timing_n": (6,), "timing_steps": 2, "timing_runs": 1, "coef_grid": (0.0, 20.0),
-         "coef_divisor": 1, "main_methods": ("tsd", "tsd-c", "ted", "gnn"),
+         "coef_divisor": 1, "main_methods": ("tsd-rect", "tsd-rect-noself", "tsd-rect-c", "tsd", "tsd-c", "ted",
+                          "gnn"),
          "coef_methods": ("tsd-t1",), "timing_methods": ("tsd-c", "tsd-c-pregate")}
 
 
@@ -59,5 +61,13 @@ SUMMARY = ROOT / "docs" / "papers" / "dong2015" / "summary.json"
 def test_page_tables_match_the_committed_summary():
     from assocopt.reproduce import dong2015 as repro
     summary = check_page_against_summary(repro, "dong2015", PAGE, SUMMARY)
-    assert summary["runs"] == 50 and summary["seed"] == 0
+    assert summary["seed"] == 0
+    stated = re.search(r"\*\*(\d+) runs\s+x\s+(\d+) steps\*\*", PAGE.read_text(encoding="utf-8"))
+    assert stated and int(stated.group(1)) == summary["runs"]
+    assert int(stated.group(2)) == summary["parameters"]["ours"]["scenario"]["n_steps"]
+    labels = {r["method"] for r in summary["records"] if r["experiment"] == "main"}
+    assert {"tsd-rect", "tsd-rect-noself", "tsd", "tsd-rect-obj", "tsd-rect-refcov",
+            "tsd-rect-inflate"} <= labels
     assert all(r["agree"] for r in summary["lap_paths"] if "agree" in r)
+    tables = (SUMMARY.parent / "tables.md").read_text(encoding="utf-8")
+    assert tables == repro.render_tables(summary)

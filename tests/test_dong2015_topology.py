@@ -10,8 +10,9 @@ import numpy as np
 import pytest
 from scipy.stats import chi2
 
-from assocopt.tracking.decide.topology import (LARGE, TopologyParams, coarse_pregate,
-                                               phi_matrix, phi_reference, prepare,
+from assocopt.tracking.decide.topology import (LARGE, TopologyParams, assign_pairs,
+                                               coarse_pregate, degree_matrix, phi_matrix,
+                                               phi_reference, prepare, thresholds,
                                                trial_pairs)
 from assocopt.tracking.topology import (all_distances, chi2_gate, heading_jacobians,
                                         heading_variance, headings, pair_distances,
@@ -120,7 +121,11 @@ OPTIONS = [{}, {"degree": "objective"}, {"ref_cov": True, "frame": "full"},
            {"ref_cov": True, "inflate": True}, {"assignment": "rectangular"},
            {"frame": "full"}, {"inflate": True},
            {"metric": "euclidean"}, {"threshold": "heading", "coef": 50.0},
-           {"min_pairs": 3}, {"assignment": "rectangular", "metric": "euclidean"}]
+           {"min_pairs": 3}, {"assignment": "rectangular", "metric": "euclidean"},
+           {"assignment": "rectangular", "self_pair": "exclude"},
+           {"assignment": "rectangular", "ref_cov": True, "inflate": True,
+            "degree": "objective"},
+           {"self_pair": "exclude"}, {"frame": "full", "self_pair": "include"}]
 
 
 def _option_id(kw) -> str:
@@ -142,6 +147,40 @@ def test_compiled_phi_agrees_with_solve_one_pair_at_a_time(kw, seed):
     assert np.allclose(phi, phi_r, rtol=1e-9)
     assert (phi[M < p.min_pairs] == LARGE).all()
     assert (M > 0).any()
+
+
+@pytest.mark.parametrize("kw", OPTIONS, ids=_option_id)
+def test_shared_assignment_gives_the_same_phi_for_every_degree(kw):
+    rng = np.random.default_rng(8)
+    X1, P1 = _tracks(rng, 7, spread=3000.0, speed=150.0)
+    X2 = X1 + rng.normal(0, [60, 60, 4, 4], X1.shape)
+    base = TopologyParams(**kw)
+    inp = prepare(X1, P1, X2[:6], P1[:6], base)
+    cols, gam = assign_pairs(inp, base)
+    for extra in ({}, {"self_pair": "exclude"}, {"self_pair": "include"},
+                  {"degree": "objective"}, {"min_pairs": 3}):
+        p = TopologyParams(**{**kw, **extra})
+        phi, M = phi_matrix(inp, p)
+        phi_s, M_s = degree_matrix(cols, gam, thresholds(inp, p), p)
+        assert (M == M_s).all() and np.allclose(phi, phi_s, rtol=1e-12)
+
+
+def test_self_pair_is_separate_from_the_frame():
+    assert TopologyParams().self_pair == "include"
+    assert TopologyParams(frame="full").self_pair == "exclude"
+    assert TopologyParams(frame="full", self_pair="include").self_pair == "include"
+    assert TopologyParams(self_pair="exclude").frame == "position"
+    with pytest.raises(ValueError, match="self_pair"):
+        TopologyParams(self_pair="both")
+    rng = np.random.default_rng(9)
+    X1, P1 = _tracks(rng, 6, spread=3000.0, speed=150.0)
+    X2 = X1 + rng.normal(0, [60, 60, 4, 4], X1.shape)
+    for kw in ({}, {"assignment": "rectangular"}):
+        inc, exc = TopologyParams(**kw), TopologyParams(self_pair="exclude", **kw)
+        _, M_in = phi_matrix(prepare(X1, P1, X2, P1, inc), inc)
+        _, M_ex = phi_matrix(prepare(X1, P1, X2, P1, exc), exc)
+        # leaving the reference pair out drops at most that one pair from each count
+        assert ((M_in - M_ex >= 0) & (M_in - M_ex <= 1)).all() and (M_in > M_ex).any()
 
 
 def test_pregate_skips_pairs_and_phi_leaves_them_large():

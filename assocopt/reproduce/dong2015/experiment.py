@@ -12,6 +12,7 @@ Three experiments, each with its own store ``OUT/dong2015-*.sqlite``:
 
 from __future__ import annotations
 
+import os
 import time
 from typing import Any, Mapping, Sequence
 
@@ -24,8 +25,8 @@ from ...tracking.scenarios.dong2015 import OURS as SCENARIO_OURS, Dong2015
 from ...tracking.scenarios.dong2015_assoc import METHODS, run_method
 from ...tracking.topology import chi2_gate
 
-__all__ = ["DEFAULTS", "PAPER", "LABELS", "experiments", "trial", "parameters",
-           "lap_paths"]
+__all__ = ["DEFAULTS", "PAPER", "LABELS", "LAP_READINGS", "experiments", "trial",
+           "parameters", "lap_paths"]
 
 _SCENARIO = ("n_steps", "T", "sensor2_x", "sigma_r", "sigma_az_deg", "bias_r",
              "bias_az_deg", "q", "missed", "false_tracks")
@@ -37,14 +38,15 @@ DEFAULTS: dict[str, Any] = {
        for k, v in Dong2015().as_dict().items() if k in _SCENARIO},
     "n_targets": 30, "alpha": 0.01, "coef": 20.0, "euclid_gate_m": 1000.0,
     "ir_schedule": "dynamic", "ir_R_max": 4, "pregate_alpha": 0.01,
-    "main_methods": ("tsd", "tsd-t1", "tsd-full", "tsd-global", "tsd-min5", "tsd-obj",
-                     "tsd-inflate", "tsd-c", "tsd-c-pregate", "tsd-c-global", "ted",
-                     "ted-obj", "nn", "gnn"),
+    "main_methods": ("tsd-rect", "tsd-rect-noself", "tsd-rect-obj", "tsd-rect-refcov",
+                     "tsd-rect-inflate", "tsd-rect-c", "tsd-rect-noself-c", "ted-rect",
+                     "ted-rect-noself", "tsd", "tsd-min5", "tsd-obj", "tsd-c",
+                     "tsd-c-global", "nn", "gnn"),
     "coef_methods": ("tsd-t1", "ted-t1", "tsd-obj-t1", "ted-obj-t1"),
     "coef_grid": (0.0, 5.0, 20.0, 50.0, 200.0),
     "coef_divisor": 2,
-    "timing_n": (10, 20, 30, 50, 70, 100),
-    "timing_methods": ("tsd-c", "tsd-c-pregate", "ted-obj", "gnn"),
+    "timing_n": (10, 20, 30, 50),
+    "timing_methods": ("tsd-rect", "tsd-c", "tsd-c-pregate", "ted-obj", "gnn"),
     "timing_runs": 3,
     "timing_steps": 4,
 }
@@ -75,14 +77,25 @@ PAPER = {
 }
 
 LABELS = {
-    "tsd": "TSD as reconstructed", "tsd-t1": "TSD + T_1 substitute (ours)",
-    "tsd-full": "TSD, full-state frame", "tsd-rect": "TSD, rectangular assignment",
-    "tsd-global": "TSD, global trial pairs", "tsd-min5": "TSD, lambda from >= 5 pairs",
-    "tsd-obj": "TSD, objective degree (ours)",
-    "tsd-inflate": "TSD, objective + heading variance (ours)",
-    "tsd-c": "TSD corrected (ours)", "tsd-c-pregate": "TSD corrected + pre-gate (ours)",
-    "tsd-c-global": "TSD corrected, global trial pairs (ours)",
-    "ted": "TED (Euclidean) as reconstructed", "ted-obj": "TED, objective degree (ours)",
+    "tsd-rect": "TSD, paper's reading (assign, then gate; self pair in lambda)",
+    "tsd-rect-noself": "TSD, paper's reading, neighbour pairs only (self pair out)",
+    "tsd-rect-obj": "paper's reading + objective degree (ours)",
+    "tsd-rect-refcov": "paper's reading + reference covariance (ours, modelling)",
+    "tsd-rect-inflate": "paper's reading + heading variance (ours, T_1 substitute)",
+    "tsd-rect-c": "paper's reading + all three (ours)",
+    "tsd-rect-noself-c": "neighbour-pairs reading + all three (ours)",
+    "ted-rect": "TED, paper's reading (self pair in lambda)",
+    "ted-rect-noself": "TED, paper's reading, neighbour pairs only",
+    "tsd": "TSD, dummy reading (ours)", "tsd-t1": "TSD dummy + T_1 substitute (ours)",
+    "tsd-full": "TSD dummy, full-state frame (ours)",
+    "tsd-global": "TSD dummy, global trial pairs (ours)",
+    "tsd-min5": "TSD dummy, lambda from >= 5 pairs (ours)",
+    "tsd-obj": "TSD dummy + objective degree (ours)",
+    "tsd-inflate": "TSD dummy + objective + heading variance (ours)",
+    "tsd-c": "TSD dummy + all three (ours)",
+    "tsd-c-pregate": "TSD dummy + all three + pre-gate (ours)",
+    "tsd-c-global": "TSD dummy + all three, global trial pairs (ours)",
+    "ted": "TED, dummy reading (ours)", "ted-obj": "TED dummy + objective degree (ours)",
     "ted-t1": "TED + T_1 substitute (ours)", "tsd-obj-t1": "TSD objective + T_1 substitute (ours)",
     "ted-obj-t1": "TED objective + T_1 substitute (ours)",
     "nn": "NN on biased tracks", "gnn": "GNN (2-D assignment) on biased tracks",
@@ -125,7 +138,8 @@ def trial(setting: Mapping[str, Any], methods: Sequence[str],
     """One simulated run associated by every method (module level: picklable)."""
     _warm_up()
     run = _scenario(setting).simulate(np.random.default_rng(seed))
-    return {m: run_method(run, m, setting) for m in methods}
+    cache: dict = {}                       # one run's assignments, shared by readings
+    return {m: run_method(run, m, setting, cache) for m in methods}
 
 
 def experiments(runs: int, seed: int, options: Mapping[str, Any] | None = None,
@@ -153,30 +167,42 @@ def experiments(runs: int, seed: int, options: Mapping[str, Any] | None = None,
     return out
 
 
+#: Readings timed per step by :func:`lap_paths`: (key, TopologyParams options).
+LAP_READINGS = (("paper", {"assignment": "rectangular"}),
+                ("paper_noself", {"assignment": "rectangular", "self_pair": "exclude"}),
+                ("rect_c", {"assignment": "rectangular", "degree": "objective",
+                            "inflate": True, "ref_cov": True}),
+                ("compiled", {"degree": "objective", "inflate": True, "ref_cov": True}))
+
+
 def lap_paths(seed: int = 0, sizes: Sequence[int] = (10, 30, 50), repeat: int = 3
               ) -> list[dict[str, Any]]:
-    """Time of one step's Phi (ms) by the compiled loop (dummies and rectangular) and
-    through ``assocopt.solve`` one pair at a time, on environment 2 at its last step;
-    and whether the two agree."""
+    """Time of one step's Phi (ms) by the compiled loop for each reading of
+    :data:`LAP_READINGS` (``compiled``: the dummy reading with our three changes) and
+    through ``assocopt.solve`` one pair at a time, on environment 2 at its first and
+    last step (the first, with its wide heading variances, is the costliest); whether
+    the two agree; the 1-minute load average while timing."""
     out = []
     for n in sizes:
         run = Dong2015(env=2, n_targets=int(n)).simulate(np.random.default_rng(seed))
-        st = run.steps[-1]
-        row: dict[str, Any] = {"n_targets": int(n)}
-        for name, kw in (("compiled", {}), ("compiled_rect", {"assignment": "rectangular"})):
-            p = TopologyParams(degree="objective", inflate=True, ref_cov=True, **kw)
-            inp = prepare(st.X1, st.P1, st.X2, st.P2, p)
-            phi_matrix(inp, p)                                     # compile / warm up
-            t0 = time.perf_counter()
-            for _ in range(repeat):
-                phi, M = phi_matrix(prepare(st.X1, st.P1, st.X2, st.P2, p), p)
-            row[f"{name}_ms"] = 1e3 * (time.perf_counter() - t0) / repeat
+        row: dict[str, Any] = {"n_targets": int(n), "load": os.getloadavg()[0]}
+        for name, kw in LAP_READINGS:
+            p = TopologyParams(**kw)
+            for where, st in (("first", run.steps[0]), ("last", run.steps[-1])):
+                inp = prepare(st.X1, st.P1, st.X2, st.P2, p)
+                phi_matrix(inp, p)                                  # compile / warm up
+                t0 = time.perf_counter()
+                for _ in range(repeat):
+                    phi, M = phi_matrix(prepare(st.X1, st.P1, st.X2, st.P2, p), p)
+                key = f"{name}_ms" if where == "last" else f"{name}_first_ms"
+                row[key] = 1e3 * (time.perf_counter() - t0) / repeat
             if name == "compiled" and n <= 30:
                 t0 = time.perf_counter()
                 ref, M_ref = phi_reference(inp, p)
                 row["solve_ms"] = 1e3 * (time.perf_counter() - t0)
                 row["agree"] = bool(np.allclose(ref, phi) and (M_ref == M).all())
                 row.update(_assignment_only(inp, p))
+        row["load_end"] = os.getloadavg()[0]
         out.append(row)
     return out
 
@@ -223,6 +249,7 @@ def parameters(options: Mapping[str, Any] | None = None) -> dict[str, Any]:
             "timing": {"n": list(o["timing_n"]), "runs": o["timing_runs"],
                        "steps": o["timing_steps"]},
             "fuzzy_method": "left out: ref. [10]'s fuzzy factor spreads and coefficients "
-                            "are not in the paper",
+                            "are not in the paper; so untested: fuzzy worst in Figs. 5-7, "
+                            "fuzzy fastest in Table 1",
         },
     }

@@ -15,7 +15,7 @@ from .report import lookup, steps_of
 __all__ = ["make_figures", "FIG_METHODS"]
 
 #: Methods drawn in the per-environment figures (all are in the tables).
-FIG_METHODS = ("tsd", "ted", "tsd-obj", "ted-obj", "tsd-c", "tsd-c-global", "gnn")
+FIG_METHODS = ("tsd-rect", "tsd-rect-noself", "ted-rect", "tsd-rect-c", "tsd", "tsd-c", "gnn")
 
 
 def make_figures(summary: Mapping[str, Any], out) -> list[str]:

@@ -58,6 +58,32 @@ def _quad2(b00, b01, b11, d0, d1):
 
 
 @njit(cache=True)
+def _entry(x1, p1, j1, x2, p2, j2, a1, a2, euclid, cut):
+    """One ``gamma_ij(u, v)`` (or squared Euclidean distance of the positions when
+    ``euclid``); the position-block lower bound instead when that is ``>= cut``."""
+    d0 = x1[0] - x2[0]
+    d1 = x1[1] - x2[1]
+    if euclid:
+        return d0 * d0 + d1 * d1
+    b00 = p1[0, 0] + p2[0, 0] + a1 * j1[0] * j1[0] + a2 * j2[0] * j2[0]
+    b01 = p1[0, 1] + p2[0, 1] + a1 * j1[0] * j1[1] + a2 * j2[0] * j2[1]
+    b11 = p1[1, 1] + p2[1, 1] + a1 * j1[1] * j1[1] + a2 * j2[1] * j2[1]
+    lb = _quad2(b00, b01, b11, d0, d1)
+    if lb >= cut:
+        return lb
+    d2 = x1[2] - x2[2]
+    d3 = x1[3] - x2[3]
+    b02 = p1[0, 2] + p2[0, 2] + a1 * j1[0] * j1[2] + a2 * j2[0] * j2[2]
+    b03 = p1[0, 3] + p2[0, 3] + a1 * j1[0] * j1[3] + a2 * j2[0] * j2[3]
+    b12 = p1[1, 2] + p2[1, 2] + a1 * j1[1] * j1[2] + a2 * j2[1] * j2[2]
+    b13 = p1[1, 3] + p2[1, 3] + a1 * j1[1] * j1[3] + a2 * j2[1] * j2[3]
+    b22 = p1[2, 2] + p2[2, 2] + a1 * j1[2] * j1[2] + a2 * j2[2] * j2[2]
+    b23 = p1[2, 3] + p2[2, 3] + a1 * j1[2] * j1[3] + a2 * j2[2] * j2[3]
+    b33 = p1[3, 3] + p2[3, 3] + a1 * j1[3] * j1[3] + a2 * j2[3] * j2[3]
+    return _quad4(b00, b01, b02, b03, b11, b12, b13, b22, b23, b33, d0, d1, d2, d3)
+
+
+@njit(cache=True)
 def pair_matrix(X1r, P1r, X2r, P2r, J1, var1, J2, var2, u, v, inflate, euclid, G, cut):
     """Fill ``G[i, j] = gamma_ij(u, v)`` (or the squared Euclidean distance of the
     positions when ``euclid``).  Entries whose position-block lower bound is already
@@ -67,36 +93,9 @@ def pair_matrix(X1r, P1r, X2r, P2r, J1, var1, J2, var2, u, v, inflate, euclid, G
     a1 = var1[u] if inflate else 0.0
     a2 = var2[v] if inflate else 0.0
     for i in range(n1):
-        x1 = X1r[u, i]
-        p1 = P1r[u, i]
-        j1 = J1[u, i]
         for j in range(n2):
-            x2 = X2r[v, j]
-            d0 = x1[0] - x2[0]
-            d1 = x1[1] - x2[1]
-            if euclid:
-                G[i, j] = d0 * d0 + d1 * d1
-                continue
-            p2 = P2r[v, j]
-            j2 = J2[v, j]
-            b00 = p1[0, 0] + p2[0, 0] + a1 * j1[0] * j1[0] + a2 * j2[0] * j2[0]
-            b01 = p1[0, 1] + p2[0, 1] + a1 * j1[0] * j1[1] + a2 * j2[0] * j2[1]
-            b11 = p1[1, 1] + p2[1, 1] + a1 * j1[1] * j1[1] + a2 * j2[1] * j2[1]
-            lb = _quad2(b00, b01, b11, d0, d1)
-            if lb >= cut:
-                G[i, j] = lb
-                continue
-            d2 = x1[2] - x2[2]
-            d3 = x1[3] - x2[3]
-            b02 = p1[0, 2] + p2[0, 2] + a1 * j1[0] * j1[2] + a2 * j2[0] * j2[2]
-            b03 = p1[0, 3] + p2[0, 3] + a1 * j1[0] * j1[3] + a2 * j2[0] * j2[3]
-            b12 = p1[1, 2] + p2[1, 2] + a1 * j1[1] * j1[2] + a2 * j2[1] * j2[2]
-            b13 = p1[1, 3] + p2[1, 3] + a1 * j1[1] * j1[3] + a2 * j2[1] * j2[3]
-            b22 = p1[2, 2] + p2[2, 2] + a1 * j1[2] * j1[2] + a2 * j2[2] * j2[2]
-            b23 = p1[2, 3] + p2[2, 3] + a1 * j1[2] * j1[3] + a2 * j2[2] * j2[3]
-            b33 = p1[3, 3] + p2[3, 3] + a1 * j1[3] * j1[3] + a2 * j2[3] * j2[3]
-            G[i, j] = _quad4(b00, b01, b02, b03, b11, b12, b13, b22, b23, b33,
-                             d0, d1, d2, d3)
+            G[i, j] = _entry(X1r[u, i], P1r[u, i], J1[u, i], X2r[v, j], P2r[v, j],
+                             J2[v, j], a1, a2, euclid, cut)
 
 
 @njit(cache=True)
@@ -147,18 +146,87 @@ def _gated_matching(G, t, rows, cols, A):
 
 
 @njit(cache=True)
+def _pair_assignment(X1r, P1r, X2r, P2r, J1, var1, J2, var2, u, v, inflate, euclid, t,
+                     dummy, exclude_ref, G, A, rows, cols, col):
+    """The assignment of one reference pair (u, v) into ``col`` (``-1``: none), with
+    ``G`` exact wherever ``G <= t``; False (``col`` untouched) when no entry is under
+    the gate ``t`` (other than (u, v) when ``exclude_ref``), so nothing can be
+    confirmed whatever the assignment -- told by the position-block lower bounds alone.
+
+    ``dummy`` False: the rectangular assignment (the smaller side assigned completely,
+    the matrix padded with zero rows or columns, every distance exact); True: a dummy
+    per row and column at half the gate, solved over the gated entries only."""
+    n1 = X1r.shape[1]
+    n2 = X2r.shape[1]
+    n = A.shape[0]
+    pair_matrix(X1r, P1r, X2r, P2r, J1, var1, J2, var2, u, v, inflate, euclid, G, t)
+    under = 0
+    for i in range(n1):
+        for j in range(n2):
+            if G[i, j] <= t and not (exclude_ref and i == u and j == v):
+                under += 1
+    if under == 0:
+        return False
+    if dummy:
+        c = _gated_matching(G, t, rows, cols, A)
+        for i in range(n1):
+            col[i] = c[i]
+        return True
+    pair_matrix(X1r, P1r, X2r, P2r, J1, var1, J2, var2, u, v, inflate, euclid, G, INF)
+    for i in range(n):
+        for j in range(n):
+            A[i, j] = min(G[i, j], 1e300) if (i < n1 and j < n2) else 0.0
+    _, c, _, _, _ = hungarian(A)
+    for i in range(n1):
+        col[i] = c[i] if c[i] < n2 else -1
+    return True
+
+
+@njit(cache=True)
+def assign_kernel(X1r, P1r, X2r, P2r, J1, var1, J2, var2, inflate, euclid, thr, dummy,
+                  active):
+    """Every reference pair's assignment: ``(cols, gam)`` with ``cols[u, v, i]`` the
+    sensor-2 track assigned to neighbour i under (u, v) (``-1``: none, or the pair
+    not solved because nothing is under its gate or it is not ``active``) and
+    ``gam[u, v, i]`` its distance (``inf`` where ``cols`` is ``-1``)."""
+    n1 = X1r.shape[1]
+    n2 = X2r.shape[1]
+    n = max(n1, n2)
+    out = np.full((n1, n2, n1), -1, np.int64)
+    gam = np.full((n1, n2, n1), INF)
+    G = np.empty((n1, n2))
+    A = np.zeros((n, n))
+    rows = np.empty(n1, np.int64)
+    cols = np.empty(n2, np.int64)
+    col = np.empty(n1, np.int64)
+    for u in range(n1):
+        for v in range(n2):
+            if not active[u, v]:
+                continue
+            if not _pair_assignment(X1r, P1r, X2r, P2r, J1, var1, J2, var2, u, v,
+                                    inflate, euclid, thr[u, v], dummy, False, G, A,
+                                    rows, cols, col):
+                continue
+            for i in range(n1):
+                j = col[i]
+                if j >= 0:
+                    out[u, v, i] = j
+                    gam[u, v, i] = G[i, j]
+    return out, gam
+
+
+@njit(cache=True)
 def phi_kernel(X1r, P1r, X2r, P2r, J1, var1, J2, var2, inflate, euclid, thr, dummy,
                exclude_ref, min_pairs, active, large, objective):
     """``(phi, M)``: lambda_uv and the number of confirmed pairs for every (u, v).
 
-    Per pair: the rectangular assignment (``dummy`` False: the smaller side assigned
-    completely, the matrix padded with zero rows or columns), or the assignment with a
-    dummy per row and column at half the gate (``dummy`` True), solved over the gated
-    entries only; then the assigned pairs with ``gamma <= t`` are confirmed.  Pairs
-    with ``active`` False are skipped (``large``, 0).  ``objective``: lambda is the
-    assignment's cost per track with every unconfirmed track at the gate,
-    ``(sum of confirmed gamma + (N - M) t) / N``, ``N = min(n1, n2)`` (less the
-    reference pair when it is left out), instead of the mean over the confirmed pairs.
+    Per pair the assignment of :func:`_pair_assignment` (rectangular, or with dummies
+    at half the gate); then the assigned pairs with ``gamma <= t`` are confirmed (the
+    pair (u, v) itself not, when ``exclude_ref``).  Pairs with ``active`` False are
+    skipped (``large``, 0).  ``objective``: lambda is the assignment's cost per track
+    with every unconfirmed track at the gate, ``(sum of confirmed gamma + (N - M) t) /
+    N``, ``N = min(n1, n2)`` (less the reference pair when it is left out), instead of
+    the mean over the confirmed pairs.
     """
     n1 = X1r.shape[1]
     n2 = X2r.shape[1]
@@ -175,17 +243,10 @@ def phi_kernel(X1r, P1r, X2r, P2r, J1, var1, J2, var2, inflate, euclid, thr, dum
             if not active[u, v]:
                 continue
             t = thr[u, v]
-            pair_matrix(X1r, P1r, X2r, P2r, J1, var1, J2, var2, u, v, inflate, euclid, G,
-                        t if dummy else INF)
-            if dummy:
-                col = _gated_matching(G, t, rows, cols, A)
-            else:
-                for i in range(n):
-                    for j in range(n):
-                        A[i, j] = min(G[i, j], 1e300) if (i < n1 and j < n2) else 0.0
-                _, c, _, _, _ = hungarian(A)
-                for i in range(n1):
-                    col[i] = c[i] if c[i] < n2 else -1
+            if not _pair_assignment(X1r, P1r, X2r, P2r, J1, var1, J2, var2, u, v,
+                                    inflate, euclid, t, dummy, exclude_ref, G, A, rows,
+                                    cols, col):
+                continue
             s = 0.0
             m = 0
             for i in range(n1):

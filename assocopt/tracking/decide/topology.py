@@ -19,16 +19,25 @@ Options (:class:`TopologyParams`; every reading not fixed by the paper is named)
     ``metric``      ``"statistical"`` (gamma, the paper's) or ``"euclidean"`` (squared
                     distance of the positions, the Euclidean baseline);
     ``frame``       ``"position"`` (positions translated, velocities rotated) or ``"full"``
-                    (whole state subtracted; the reference pair is then left out of
-                    lambda, since it is the zero vector on both sensors);
+                    (whole state subtracted: the reference is then the zero vector on
+                    both sensors);
+    ``self_pair``   ``"include"`` (the reference pair (u, v) itself counts among the
+                    confirmed pairs of lambda, as the paper converts "the data of target u
+                    itself" too) or ``"exclude"`` (only the *neighbour* pairs count, as the
+                    abstract's wording has it); it stays in the assignment either way.
+                    Default (``None``): ``"exclude"`` with the full-state frame (where it
+                    would always confirm itself at gamma = 0), ``"include"`` otherwise;
     ``assignment``  ``"dummy"`` (default: a dummy per row and column at half the gate,
                     so a pair is used only when it beats leaving both tracks out; solved
                     over the gated entries only, which is exact and fast) or
-                    ``"rectangular"`` (the smaller side fully assigned, then gated; every
-                    pair needs a full n x n Hungarian, about 15x slower at 30 targets);
-    ``inflate``     add the reference headings' variance to B (ours);
+                    ``"rectangular"`` (the paper's order: the smaller side fully assigned,
+                    then gated; exact, with distances computed lazily, see
+                    :func:`~assocopt.tracking.decide._topology_kernel.phi_kernel`);
+    ``inflate``     add the reference headings' variance to B (ours: a substitute for the
+                    paper's heading-adjusted threshold T_1, whose formula is lost);
     ``ref_cov``     first-order covariance of the offsets from the reference: adds the
-                    reference's own position covariance (ours; the paper rotates P_i only);
+                    reference's own position covariance (ours: a modelling improvement;
+                    the paper rotates P_i only);
     ``degree``      ``"mean"`` (the paper's lambda: mean gamma over the confirmed pairs) or
                     ``"objective"`` (ours: the assignment cost per track with every
                     unconfirmed track at the gate, so a pair confirming few neighbours can
@@ -51,7 +60,7 @@ from ..topology import (check_tracks, chi2_gate, heading_jacobians, heading_vari
                         pair_distances, reference_frames)
 
 __all__ = ["TopologyParams", "StepInputs", "prepare", "thresholds", "pair_gammas",
-           "phi_matrix", "phi_reference",
+           "phi_matrix", "phi_reference", "assign_pairs", "degree_matrix",
            "coarse_pregate", "trial_pairs", "LARGE"]
 
 #: "A sufficiently large value" of lambda_uv when (u, v) has no confirmed pair.
@@ -73,13 +82,15 @@ class TopologyParams:
     alpha: float = 0.01
     euclid_gate_m: float = 1000.0
     min_pairs: int = 1
+    self_pair: str | None = None        # last: positional construction keeps working
 
     def __post_init__(self) -> None:
         for name, valid in (("metric", ("statistical", "euclidean")),
                             ("frame", ("position", "full")),
                             ("assignment", ("rectangular", "dummy")),
                             ("threshold", ("chi2", "heading")),
-                            ("degree", ("mean", "objective"))):
+                            ("degree", ("mean", "objective")),
+                            ("self_pair", (None, "include", "exclude"))):
             if getattr(self, name) not in valid:
                 raise ValueError(f"{name} must be one of {valid}, got {getattr(self, name)!r}")
         if self.coef < 0 or self.euclid_gate_m <= 0:
@@ -87,6 +98,9 @@ class TopologyParams:
         if not isinstance(self.min_pairs, int) or self.min_pairs < 1:
             raise ValueError(f"min_pairs must be a positive integer, got {self.min_pairs!r}")
         chi2_gate(self.alpha, 4)
+        if self.self_pair is None:
+            object.__setattr__(self, "self_pair",
+                               "exclude" if self.frame == "full" else "include")
 
     def base_gate(self) -> float:
         """delta(alpha, 4) for the statistical distance, the squared gate in m^2 for the
@@ -133,6 +147,18 @@ def thresholds(inp: StepInputs, params: TopologyParams) -> np.ndarray:
     return g * (1.0 + params.coef * v)
 
 
+def _kernel_args(inp: StepInputs, params: TopologyParams, active):
+    n1, n2 = inp.X1r.shape[1], inp.X2r.shape[1]
+    act = np.ones((n1, n2), bool) if active is None else np.asarray(active, bool)
+    if act.shape != (n1, n2):
+        raise ValueError(f"active must have shape {(n1, n2)}, got {act.shape}")
+    v1 = np.where(np.isfinite(inp.var1), inp.var1, 1e6)
+    v2 = np.where(np.isfinite(inp.var2), inp.var2, 1e6)
+    return (inp.X1r, inp.P1r, inp.X2r, inp.P2r, inp.J1, v1, inp.J2, v2, params.inflate,
+            params.metric == "euclidean", thresholds(inp, params),
+            params.assignment == "dummy"), act
+
+
 def phi_matrix(inp: StepInputs, params: TopologyParams,
                active: np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray]:
     """``(Phi, M)``: lambda_uv and the confirmed-pair count of every reference pair
@@ -141,15 +167,47 @@ def phi_matrix(inp: StepInputs, params: TopologyParams,
     n1, n2 = inp.X1r.shape[1], inp.X2r.shape[1]
     if n1 == 0 or n2 == 0:
         return np.full((n1, n2), LARGE), np.zeros((n1, n2), np.int64)
-    act = np.ones((n1, n2), bool) if active is None else np.asarray(active, bool)
-    if act.shape != (n1, n2):
-        raise ValueError(f"active must have shape {(n1, n2)}, got {act.shape}")
-    v1 = np.where(np.isfinite(inp.var1), inp.var1, 1e6)
-    v2 = np.where(np.isfinite(inp.var2), inp.var2, 1e6)
-    return phi_kernel(inp.X1r, inp.P1r, inp.X2r, inp.P2r, inp.J1, v1, inp.J2, v2,
-                      params.inflate, params.metric == "euclidean", thresholds(inp, params),
-                      params.assignment == "dummy", params.frame == "full",
-                      params.min_pairs, act, LARGE, params.degree == "objective")
+    args, act = _kernel_args(inp, params, active)
+    return phi_kernel(*args, params.self_pair == "exclude", params.min_pairs, act, LARGE,
+                      params.degree == "objective")
+
+
+def assign_pairs(inp: StepInputs, params: TopologyParams,
+                 active: np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray]:
+    """Every reference pair's assignment, before any degree is formed: ``(cols,
+    gam)``, ``cols[u, v, i]`` the sensor-2 track assigned to neighbour i under (u, v)
+    (``-1``: none, or nothing under the gate) and ``gam[u, v, i]`` its distance.
+    :func:`degree_matrix` turns them into Phi for any ``self_pair``, ``degree`` and
+    ``min_pairs`` (which do not change the assignment), so several readings can share
+    one solve; ``degree_matrix(*assign_pairs(inp, p), thresholds(inp, p), p)`` equals
+    ``phi_matrix(inp, p)``."""
+    from ._topology_kernel import assign_kernel
+    n1, n2 = inp.X1r.shape[1], inp.X2r.shape[1]
+    if n1 == 0 or n2 == 0:
+        return np.full((n1, n2, n1), -1, np.int64), np.full((n1, n2, n1), np.inf)
+    args, act = _kernel_args(inp, params, active)
+    return assign_kernel(*args, act)
+
+
+def degree_matrix(cols: np.ndarray, gam: np.ndarray, thr: np.ndarray,
+                  params: TopologyParams) -> tuple[np.ndarray, np.ndarray]:
+    """``(Phi, M)`` from :func:`assign_pairs`' output and the gates ``thr``."""
+    n1, n2 = thr.shape
+    ok = (cols >= 0) & (gam <= thr[:, :, None])
+    if params.self_pair == "exclude" and n1 and n2:
+        u = np.arange(n1)[:, None]
+        ok[u, np.arange(n2)[None, :], u] &= cols[u, np.arange(n2)[None, :], u] != \
+            np.arange(n2)[None, :]
+    M = ok.sum(-1)
+    s = np.where(ok, gam, 0.0).sum(-1)
+    phi = np.full((n1, n2), LARGE)
+    real = (M > 0) & (M >= params.min_pairs)
+    if params.degree == "objective":
+        nn = min(n1, n2) - (params.self_pair == "exclude")
+        phi[real] = (s[real] + (nn - M[real]) * thr[real]) / nn
+    else:
+        phi[real] = s[real] / M[real]
+    return phi, M.astype(np.int64)
 
 
 def pair_gammas(inp: StepInputs, params: TopologyParams, u: int, v: int) -> np.ndarray:
@@ -186,13 +244,13 @@ def phi_reference(inp: StepInputs, params: TopologyParams, solver: str = "auto",
                 prob = AssignmentProblem.dense(G)
             rows, cols = solve(prob, solver).assignment()
             ok = G[rows, cols] <= t
-            if params.frame == "full":
+            if params.self_pair == "exclude":
                 ok &= ~((rows == u) & (cols == v))
             M[u, v] = int(ok.sum())
             if M[u, v] >= params.min_pairs:
                 phi[u, v] = float(G[rows, cols][ok].mean())
                 if params.degree == "objective":
-                    nn = min(n1, n2) - (params.frame == "full")
+                    nn = min(n1, n2) - (params.self_pair == "exclude")
                     phi[u, v] = (float(G[rows, cols][ok].sum()) + (nn - M[u, v]) * t) / nn
     return phi, M
 
