@@ -375,7 +375,7 @@ def test_labels_say_as_printed_only_for_eq10_with_the_literal_selection():
         assert ("not from the paper" in lab) == (o["conflict"] != "q_final"), m
         changed = o["error"] == "scale" or o["select"] == "movable" or o["score"] == "initial"
         assert ("(ours)" in lab) == changed, m
-    assert label("did-printed@B=0.05,Mp=3") == LABELS["did-printed"] + ", tuned (B = 0.05, M′ = 3)"
+    assert label("did-printed@B=0.05,Mp=3") == LABELS["did-printed"] + ", at B = 0.05, M′ = 3"
 
 
 def test_conflict_rules_on_two_reports_choosing_one_track():
@@ -474,7 +474,9 @@ def test_reproduction_writes_summary_figures_and_resumes(tmp_path):
     main = {r["method"] for r in data["records"] if r["experiment"] == "main"}
     sweep = {r["method"] for r in data["records"] if r["experiment"] == "sweep"}
     best = {m: b["method"] for m, b in data["tuned"].items()}
-    assert main == {"did-printed", "gnn", best["did-printed"], best["did-q0"]}
+    at_best = {m + best["did-printed"][len("did-printed"):]
+               for m in repro.DEFAULTS["at_printed_best"]}
+    assert main == {"did-printed", "gnn", best["did-printed"], best["did-q0"]} | at_best
     assert sweep == {"did-printed", "nn", best["did-printed"]}
     rate = {r["method"]: r["value"] for r in data["records"]
             if r["experiment"] == "tune" and r["metric"] == "correct_rate"}

@@ -43,8 +43,9 @@ DEFAULTS: dict[str, Any] = {
     "sweep_divisor": 5,
     "tune_methods": ("did-printed", "did-dowhile", "did-zm", "did-q0"),
     "tune_B": (0.02, 0.05, 0.1, 0.2, 0.4),
-    "tune_M_prime": (3.0, 4.0, 6.0, 10.0, 20.0, 40.0),
+    "tune_M_prime": (2.0, 3.0, 4.0, 6.0, 10.0, 20.0, 40.0),
     "tune_divisor": 5,
+    "at_printed_best": ("did-printed-q0", "did-conflict-q0", "did-conflict-new"),
     "example_seed": 3,
 }
 
@@ -69,7 +70,7 @@ def label(method: str) -> str:
     base, over = split_method(method)
     if not over:
         return LABELS[base]
-    return f"{LABELS[base]}, tuned (B = {over['did_B']:g}, M′ = {over['did_M_prime']:g})"
+    return f"{LABELS[base]}, at B = {over['did_B']:g}, M′ = {over['did_M_prime']:g}"
 
 
 def tune_grid(options: Mapping[str, Any] | None = None) -> list[str]:
@@ -103,12 +104,12 @@ def _options(options: Mapping[str, Any] | None) -> dict[str, Any]:
     if unknown:
         raise ValueError(f"unknown xue1999 option(s) {sorted(unknown)}; valid: {sorted(DEFAULTS)}")
     for m in (tuple(opts["main_methods"]) + tuple(opts["sweep_methods"])
-              + tuple(opts["tune_methods"])):
+              + tuple(opts["tune_methods"]) + tuple(opts["at_printed_best"])):
         if m not in METHODS:
             raise ValueError(f"unknown xue1999 method {m!r}; valid: {sorted(METHODS)}")
-    for m in opts["tune_methods"]:
+    for m in tuple(opts["tune_methods"]) + tuple(opts["at_printed_best"]):
         if METHODS[m]["rule"] != "did":
-            raise ValueError(f"tune_methods: {m!r} is not a DID method")
+            raise ValueError(f"tune_methods / at_printed_best: {m!r} is not a DID method")
     for k in ("sweep_divisor", "tune_divisor"):
         if not isinstance(opts[k], int) or opts[k] < 1:
             raise ValueError(f"{k} must be a positive integer")
@@ -150,7 +151,9 @@ def experiments(runs: int, seed: int, options: Mapping[str, Any] | None = None,
     """The Experiments of the reproduction (``options`` override :data:`DEFAULTS`).
 
     ``tuned`` maps a tuned method to its best-pair method name (:func:`best_pairs`);
-    those are added to ``main`` and, for the sweep's methods, to ``sweep``.  The tuning
+    those are added to ``main`` and, for the sweep's methods, to ``sweep``; the
+    methods of ``at_printed_best`` (our changes to the printed rule) join ``main`` at
+    the best pair of ``did-printed`` too.  The tuning
     part's setting differs from the main one (``part``), so its trial seeds
     (:func:`~assocopt.experiments.trial_seed`) are independent of the reported ones.
     """
@@ -166,6 +169,10 @@ def experiments(runs: int, seed: int, options: Mapping[str, Any] | None = None,
     if "main" in parts:
         methods = tuple(o["main_methods"]) + tuple(tuned[m] for m in o["tune_methods"]
                                                    if m in tuned)
+        if "did-printed" in tuned:
+            best = split_method(tuned["did-printed"])[1]
+            methods += tuple(tuned_name(m, best["did_B"], best["did_M_prime"])
+                             for m in o["at_printed_best"])
         out.append(Experiment("xue1999-main", [{"part": "main", **base}], methods, trial,
                               runs, seed, params={"experiment": "main"}, volatile=VOLATILE))
     if "sweep" in parts:
@@ -203,6 +210,7 @@ def parameters(options: Mapping[str, Any] | None = None) -> dict[str, Any]:
             "noise_grid": list(o["noise_grid"]), "clutter_grid": list(o["clutter_grid"]),
             "sweep_runs": f"runs // {o['sweep_divisor']}",
             "tuning": {"methods": list(o["tune_methods"]), "B": list(o["tune_B"]),
+                       "at_printed_best": list(o["at_printed_best"]),
                        "M_prime": list(o["tune_M_prime"]),
                        "runs": f"runs // {o['tune_divisor']}",
                        "criterion": "largest mean correct_rate (ties: first in grid order)",
