@@ -215,10 +215,10 @@ def render_example() -> str:
         rel = ">" if e["q_B"] > e["q_A"] else "<"
         L.append(f"- B = {B:g}: record B's x goes to {e['x_B']:.2f}; q_B = {e['q_B']:.2f} {rel} "
                  f"q_A = {e['q_A']:.2f}, so DID picks record {e['choice']}.")
-    L.append(f"- record B outranks A exactly when {s[0]:g} + {push:g} B > {a[0]:g}, i.e. "
-             f"B > {(a[0] - s[0]) / push:.3f} (a smaller push stops below "
-             f"{0.5 + push * (a[0] - s[0]) / push:g}: every update but the last leaves x "
-             "below 0.5).")
+    L.append(f"- one update turns record B's x on when B ≥ {(0.5 - s[0]) / push:.3f}; "
+             f"record B then outranks A exactly when {s[0]:g} + {push:g} B > {a[0]:g}, "
+             f"i.e. B > {(a[0] - s[0]) / push:.3f} (with smaller B, x ends below "
+             f"{0.5 + (0.5 - s[0]):g}).")
     for B in (0.2, 0.05):
         e = two_record_example(B, min_updates=1)
         L.append(f"- step 5 as a do-while, B = {B:g}: A's x is moved too; q_A = "

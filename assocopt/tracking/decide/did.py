@@ -31,8 +31,8 @@ factors agree (all on or all off).  Step 5 ("重复第三步, 直到各关联因
 repeat step 3 until the factors agree) comes after one update (steps 3-4), so it
 reads as a while loop (``min_updates=0``: a record that already agrees is not
 moved) or as a do-while (``min_updates=1``: every record left in stage 2, even one
-already all on, gets at least one update); both are literal.  ``B`` is symmetric with entries in [0, 1] and a
-zero diagonal.  The loop is capped at ``max_iter`` updates (convergence is asserted in
+already all on, gets at least one update); both are literal.  ``B`` is symmetric
+with entries in [0, 1] and a zero diagonal.  The loop is capped at ``max_iter`` updates (convergence is asserted in
 the paper, not shown); a record that does not settle is *not converged*, is reported
 as such and is not associated (``unresolved="reject"``) or is judged by the majority
 of its factors (``"majority"``).  With ``select="literal"`` the most ambiguous factor
@@ -45,6 +45,9 @@ score ``q_k = sum_i s_on[i, k]`` over all factors (ties: the lowest index), summ
 the states after stage 2 as printed (``score="final"``) or, as our variant, over the
 stage-1 states (``score="initial"``: stage 2 inflates the states it pushes to "on",
 so a contradictory record can outscore a consistent one).
+
+The rule as printed is ``error="origin"``, ``select="literal"``, ``score="final"``
+with ``min_updates`` 0 or 1; the defaults ``"scale"`` and ``"movable"`` are ours.
 
 Stage 1 is vectorised over reports and records; stage 2 runs every unsettled
 (report, record) column through one compiled (numba) loop.
