@@ -31,12 +31,8 @@ def lookup(records, part: str, metric: str) -> dict[tuple, tuple]:
 
 def ordered(methods) -> list[str]:
     """``methods`` in the order of :data:`METHODS`, each tuned one after its base."""
-    methods = set(methods)
-    out = []
-    for base in METHODS:
-        out += [m for m in sorted(methods) if split_method(m)[0] == base
-                and (m == base or "@" in m)]
-    return sorted(out, key=lambda m: (list(METHODS).index(split_method(m)[0]), "@" in m))
+    pos = {b: i for i, b in enumerate(METHODS)}
+    return sorted(set(methods), key=lambda m: (pos[split_method(m)[0]], "@" in m, m))
 
 
 def _ci(v) -> str:
