@@ -359,8 +359,8 @@ def test_labels_say_as_printed_only_for_eq10_with_the_literal_selection():
     from assocopt.reproduce.xue1999 import LABELS, label
     assert set(LABELS) == set(METHODS)
     printed = {m for m, o in METHODS.items() if o["rule"] == "did" and
-               (o["error"], o["select"], o["score"], o["conflict"]) ==
-               ("origin", "literal", "final", "q_final")}
+               (o["error"], o["select"], o["score"], o["conflict"], o["unresolved"]) ==
+               ("origin", "literal", "final", "q_final", "reject")}
     assert printed == {"did-printed", "did-dowhile"}
     for m, o in METHODS.items():
         lab = LABELS[m]
@@ -373,7 +373,9 @@ def test_labels_say_as_printed_only_for_eq10_with_the_literal_selection():
         assert ("do-while" in lab) == (o["min_updates"] == 1), m
         assert ("conflict" in lab) == (o["conflict"] != "q_final"), m
         assert ("not from the paper" in lab) == (o["conflict"] != "q_final"), m
-        changed = o["error"] == "scale" or o["select"] == "movable" or o["score"] == "initial"
+        assert ("majority" in lab) == (o["unresolved"] == "majority"), m
+        changed = (o["error"] == "scale" or o["select"] == "movable" or o["score"] == "initial"
+                   or o["unresolved"] == "majority")
         assert ("(ours)" in lab) == changed, m
     assert label("did-printed@B=0.05,Mp=3") == LABELS["did-printed"] + ", at B = 0.05, M′ = 3"
 

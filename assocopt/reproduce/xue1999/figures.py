@@ -19,11 +19,12 @@ _COLOURS = ("tab:blue", "tab:orange", "tab:green", "tab:red")
 #: One colour per method in every figure (a tuned method: its base's, dashed).
 _METHOD_COLOURS = {"did-printed": "tab:blue", "did-dowhile": "tab:cyan",
                    "did-zscore": "tab:orange", "did-movable": "tab:green",
-                   "did-printed-q0": "tab:olive", "did-conflict-q0": "tab:pink",
+                   "did-printed-q0": "tab:olive", "did-majority": "gold",
+                   "did-conflict-q0": "tab:pink",
                    "did-conflict-new": "tab:gray", "did-zm": "black", "did-q0": "tab:red",
                    "gnn": "tab:purple", "nn": "tab:brown"}
 #: The methods of the per-scan figure (and their tuned versions).
-_PER_SCAN = ("did-printed", "did-dowhile", "did-zm", "did-q0", "gnn", "nn")
+_PER_SCAN = ("did-printed", "did-dowhile", "did-majority", "did-zm", "did-q0", "gnn", "nn")
 
 
 def _style(m: str) -> dict:

@@ -25,9 +25,8 @@ The paper says neither how stored records are created nor how they are updated
   dropped: they were judged to belong to a known target), ``"q_initial"`` (the same
   ranked by the stage-1 q) or ``"new_track"`` (largest printed q kept, the others
   start new tracks).
-* **Methods** are the keys of :data:`METHODS`, optionally with DID's B and M'
-  overridden as ``"NAME@B=0.05,Mp=3"`` (:func:`tuned_name`), the form the
-  reproduction's tuning uses.
+* **Methods**: the keys of :data:`METHODS`, or ``"NAME@B=0.05,Mp=3"`` with DID's B
+  and M' set (:func:`tuned_name`; the reproduction's tuning).
 
 >>> from assocopt.tracking.scenarios.xue1999 import Xue1999
 >>> sc = Xue1999(clutter_mean=0.0, p_d=1.0)
@@ -58,7 +57,7 @@ __all__ = ["TrackerParams", "METHODS", "CONFLICTS", "RunLog", "run_tracker", "ru
 CONFLICTS = ("q_final", "q_initial", "new_track")
 
 _PRINTED = {"rule": "did", "error": "origin", "select": "literal", "score": "final",
-            "min_updates": 0, "conflict": "q_final"}
+            "min_updates": 0, "conflict": "q_final", "unresolved": "reject"}
 #: Association methods: name -> options (``rule`` did / gnn / nn; DID options).  The
 #: DID methods are the printed rule (eq. (10) with the literal selection; step 5 as a
 #: while or a do-while loop) and the printed rule with our changes.
@@ -68,6 +67,7 @@ METHODS: dict[str, dict[str, Any]] = {
     "did-zscore": {**_PRINTED, "error": "scale"},
     "did-movable": {**_PRINTED, "select": "movable"},
     "did-printed-q0": {**_PRINTED, "score": "initial"},
+    "did-majority": {**_PRINTED, "unresolved": "majority"},
     "did-conflict-q0": {**_PRINTED, "conflict": "q_initial"},
     "did-conflict-new": {**_PRINTED, "conflict": "new_track"},
     "did-zm": {**_PRINTED, "error": "scale", "select": "movable"},
@@ -132,8 +132,8 @@ class TrackerParams:
         M = self.did_origin_M if opts["error"] == "origin" else self.did_M
         return DIDParams(M=M, M_prime=self.did_M_prime, B=self.did_B,
                          max_iter=self.did_max_iter, select=opts["select"],
-                         score=opts.get("score", "final"),
-                         min_updates=opts.get("min_updates", 0))
+                         score=opts.get("score", "final"), min_updates=opts.get("min_updates", 0),
+                         unresolved=opts.get("unresolved", "reject"))
 
     def as_dict(self) -> dict[str, Any]:
         d = asdict(self)
