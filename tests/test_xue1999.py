@@ -19,14 +19,14 @@ from assocopt.tracking.decide.nearest import gnn_assign, nearest_neighbour
 from assocopt.tracking.scenarios.xue1999 import Xue1999
 from assocopt.tracking.scenarios.xue1999_tracker import (METHODS, association_costs,
                                                          run_metrics, run_tracker)
-from conftest import check_page_against_summary
+from conftest import check_page_against_summary, page_block
 
 ROOT = Path(__file__).resolve().parents[1]
 
 
 # ------------------------------------------------ loop-based re-implementation
 def ref_did(a0, A, *, scale=None, floor=None, categorical=(), M=1.0, Mp=6.0, B=0.2,
-            max_iter=50, select="movable", score="final"):
+            max_iter=50, select="movable", score="final", min_updates=0):
     """One report, written from the paper's steps with plain loops (no numpy in bulk)."""
     m, n = len(A), len(A[0])
     s_on = [[0.0] * n for _ in range(m)]
@@ -57,9 +57,9 @@ def ref_did(a0, A, *, scale=None, floor=None, categorical=(), M=1.0, Mp=6.0, B=0
         if cols_off[j]:
             continue
         col = [s_on[i][j] for i in range(m)]
-        for _ in range(max_iter):
+        for it in range(max_iter):
             states = [on(s) for s in col]
-            if all(states) or not any(states):
+            if it >= min_updates and (all(states) or not any(states)):
                 break
             ys = [sum(Bm[i][l] * (col[l] - (1.0 - col[l])) for l in range(m) if l != i)
                   for i in range(m)]
@@ -96,11 +96,14 @@ def _random_inputs(rng, R, m, n):
     return reports, A, cat
 
 
+@pytest.mark.parametrize("min_updates", [0, 1])
 @pytest.mark.parametrize("select", ["movable", "literal"])
 @pytest.mark.parametrize("score", ["final", "initial"])
 @pytest.mark.parametrize("error", ["scale", "origin"])
-def test_did_matches_loop_reimplementation_on_random_inputs(select, score, error):
-    rng = np.random.default_rng(abs(hash((select, score, error))) % 2 ** 32)
+def test_did_matches_loop_reimplementation_on_random_inputs(select, score, error, min_updates):
+    rng = np.random.default_rng(["movable", "literal"].index(select) * 8
+                                + ["final", "initial"].index(score) * 4
+                                + ["scale", "origin"].index(error) * 2 + min_updates)
     n_stage2 = 0
     for _ in range(40):
         R, m, n = rng.integers(1, 5), rng.integers(2, 7), rng.integers(1, 6)
@@ -109,14 +112,14 @@ def test_did_matches_loop_reimplementation_on_random_inputs(select, score, error
         floor = rng.uniform(0.05, 0.5, m)
         p = DIDParams(M=float(rng.uniform(0.3, 2)), M_prime=float(rng.uniform(1, 8)),
                       B=float(rng.uniform(0, 1)), max_iter=int(rng.integers(0, 30)),
-                      select=select, score=score)
+                      select=select, score=score, min_updates=min_updates)
         kw = {"scale": scale} if error == "scale" else {"floor": floor}
         delta = relative_errors(reports, A, error=error, categorical=cat, **kw)
         res = did_decide(initial_states(delta, p), p)
         for r in range(R):
             ref = ref_did(reports[r], A.tolist(), categorical=set(np.flatnonzero(cat)),
                           M=p.M, Mp=p.M_prime, B=p.B, max_iter=p.max_iter, select=select,
-                          score=score, **({"scale": scale} if error == "scale" else
+                          score=score, min_updates=min_updates, **({"scale": scale} if error == "scale" else
                                           {"floor": floor}))
             assert res.choice[r] == ref["choice"]
             assert res.stage[r] == ref["stage"]
@@ -180,6 +183,44 @@ def test_stage2_flips_the_minority_factor_and_respects_bounds():
     lit, settled_l, _ = stage2(s, B, 100, "literal")
     assert not settled_l[0]                       # literal: saturated factor 0 stalls
     assert np.all((0 <= lit) & (lit <= 1))
+
+
+def test_do_while_moves_a_column_that_already_agrees_hand_worked():
+    # s_on (x, y, vx, vy, IFF) = (0.8, 0.8, 0.8, 0.8, 1), B = 0.05: the column agrees, so the
+    # while reading leaves it; the do-while makes one update of the most ambiguous factor
+    # (x: |0.8 - 0.5| = 0.3, the lowest index among the ties) by
+    # 0.05 * (3 * (0.8 - 0.2) + (1 - 0)) = 0.14, to 0.94, then stops (all on).
+    col = np.array([[0.8, 0.8, 0.8, 0.8, 1.0]])
+    B = strength_matrix(0.05, 5)
+    for select in ("literal", "movable"):
+        s0, settled0, it0 = stage2(col, B, 100, select, min_updates=0)
+        assert np.array_equal(s0, col) and it0.tolist() == [0] and settled0[0]
+        s1, settled1, it1 = stage2(col, B, 100, select, min_updates=1)
+        assert s1[0].tolist() == pytest.approx([0.94, 0.8, 0.8, 0.8, 1.0])
+        assert it1.tolist() == [1] and settled1[0]
+    # a contradictory column: the do-while and the while loop agree after the first update
+    mixed = np.array([[0.45, 0.8, 0.8, 0.8, 1.0]])
+    a, _, ia = stage2(mixed, B, 100, "literal", min_updates=0)
+    b, _, ib = stage2(mixed, B, 100, "literal", min_updates=1)
+    assert np.array_equal(a, b) and ia.tolist() == ib.tolist() == [1]
+    assert a[0, 0] == pytest.approx(0.59)
+    with pytest.raises(ValueError, match="min_updates"):
+        DIDParams(min_updates=-1)
+
+
+def test_two_record_example_printed_q_rewards_the_dissenting_record_only_for_large_B():
+    from assocopt.reproduce.xue1999.report import render_example, two_record_example
+    # hand computation: record B's x moves by B * (3 * 0.6 + 1) = 2.8 B, clipped at 1
+    hi, lo = two_record_example(0.2), two_record_example(0.05)
+    assert (hi["q_A"], hi["q_B"], hi["choice"]) == (pytest.approx(4.2), pytest.approx(4.4), "B")
+    assert (lo["q_A"], lo["q_B"], lo["choice"]) == (pytest.approx(4.2), pytest.approx(3.99), "A")
+    for B in (0.12, 0.13):                      # the switch at B = 0.35 / 2.8 = 0.125
+        assert two_record_example(B)["choice"] == ("B" if B > 0.125 else "A")
+    dw = two_record_example(0.05, min_updates=1)
+    assert (dw["q_A"], dw["choice"]) == (pytest.approx(4.34), "A")
+    text = render_example()
+    assert "q_B = 4.40 > q_A = 4.20" in text and "q_B = 3.99 < q_A = 4.20" in text
+    assert "B > 0.125" in text
 
 
 def test_strength_matrix_validation():
@@ -290,8 +331,92 @@ def test_every_method_tracks_an_easy_scene(method):
     sc = Xue1999(clutter_mean=0.0, p_d=1.0, noise_scale=0.3, p_iff=0.0)
     met = run_metrics(run_tracker(sc.simulate(np.random.default_rng(0)), method, sc), sc)
     assert met["false_tracks"] == 0
+    assert 0 <= met["decision_precision"] <= 1
     if method in ("gnn", "nn", "did-q0"):
         assert met["correct_rate"] > 0.95 and met["held_at_end"] == 1.0
+        assert met["decision_precision"] > 0.95
+
+
+def test_tuned_method_names_set_B_and_M_prime():
+    from assocopt.tracking.scenarios.xue1999_tracker import split_method, tuned_name
+    name = tuned_name("did-printed", 0.05, 3)
+    assert name == "did-printed@B=0.05,Mp=3"
+    assert split_method(name) == ("did-printed", {"did_B": 0.05, "did_M_prime": 3.0})
+    assert split_method("gnn") == ("gnn", {})
+    for bad in ("gnn@B=0.1,Mp=3", "did-bogus", "did-printed@B=x"):
+        with pytest.raises(ValueError, match="unknown method"):
+            split_method(bad)
+    sc = Xue1999(n_scans=8, clutter_mean=5.0)
+    scans = sc.simulate(np.random.default_rng(3))
+    from assocopt.tracking.scenarios.xue1999_tracker import TrackerParams
+    a = run_metrics(run_tracker(scans, tuned_name("did-zm", 0.05, 3), sc), sc)
+    b = run_metrics(run_tracker(scans, "did-zm", sc, TrackerParams(did_B=0.05,
+                                                                   did_M_prime=3.0)), sc)
+    assert a == b
+
+
+def test_labels_say_as_printed_only_for_eq10_with_the_literal_selection():
+    from assocopt.reproduce.xue1999 import LABELS, label
+    assert set(LABELS) == set(METHODS)
+    printed = {m for m, o in METHODS.items() if o["rule"] == "did" and
+               (o["error"], o["select"], o["score"], o["conflict"], o["unresolved"]) ==
+               ("origin", "literal", "final", "q_final", "reject")}
+    assert printed == {"did-printed", "did-dowhile"}
+    for m, o in METHODS.items():
+        lab = LABELS[m]
+        assert ("as printed" in lab) == (m in printed), m
+        if o["rule"] != "did":
+            continue
+        assert ("z-score" in lab) == (o["error"] == "scale"), m
+        assert ("movable" in lab) == (o["select"] == "movable"), m
+        assert ("q from stage 1" in lab) == (o["score"] == "initial"), m
+        assert ("do-while" in lab) == (o["min_updates"] == 1), m
+        assert ("conflict" in lab) == (o["conflict"] != "q_final"), m
+        assert ("not from the paper" in lab) == (o["conflict"] != "q_final"), m
+        assert ("majority" in lab) == (o["unresolved"] == "majority"), m
+        changed = (o["error"] == "scale" or o["select"] == "movable" or o["score"] == "initial"
+                   or o["unresolved"] == "majority")
+        assert ("(ours)" in lab) == changed, m
+    assert label("did-printed@B=0.05,Mp=3") == LABELS["did-printed"] + ", at B = 0.05, M′ = 3"
+
+
+def test_conflict_rules_on_two_reports_choosing_one_track():
+    from assocopt.tracking.scenarios.xue1999_tracker import RunLog, _settle_conflicts
+    # reports 0 and 1 both choose track 0; report 0 has the larger final q, report 1 the
+    # larger stage-1 q; report 2 chooses track 1 alone; report 3 is new
+    choice = np.array([0, 0, 1, -1])
+    score = np.array([4.5, 4.0, 3.0, np.nan])
+    s0 = np.zeros((4, 2, 2))
+    s0[0, :, 0] = [0.6, 0.6]
+    s0[1, :, 0] = [0.9, 0.9]
+    s0[2, :, 1] = [0.7, 0.7]
+    expect = {"q_final": ([(0, 0), (2, 1)], [False, False, False, True]),
+              "q_initial": ([(1, 0), (2, 1)], [False, False, False, True]),
+              "new_track": ([(0, 0), (2, 1)], [False, True, False, True])}
+    for rule, (pairs, init) in expect.items():
+        log = RunLog()
+        got, initiate = _settle_conflicts(choice, score, s0, rule, log)
+        assert got == pairs and initiate.tolist() == init, rule
+        assert log.did_stats["conflicts"] == 1
+    with pytest.raises(ValueError, match="conflict"):
+        _settle_conflicts(choice, score, s0, "bogus", RunLog())
+
+
+def test_decision_precision_counts_a_swap_once():
+    from assocopt.tracking.scenarios.xue1999_tracker import RunLog
+    sc = Xue1999(n_scans=6)
+    log = RunLog()
+    # one confirmed track: target 0 for three scans, then (one bad decision) target 1
+    log.owner, log.confirmed = {7: 0}, {7: True}
+    log.sources = {7: [0, 0, 0, 1, 1, 1]}
+    log.path = {7: [(k, 0.0, 0.0) for k in range(6)]}
+    log.scans = [(np.array([0, 1]), [[7], []], [] if k == 0 else [0], set())
+                 for k in range(6)]
+    met = run_metrics(log, sc)
+    assert met["decision_precision"] == pytest.approx(4 / 5)       # 5 decisions, 1 wrong
+    assert met["swaps"] == 1.0
+    log.sources = {7: [0, -1, 0, 0]}                 # clutter taken: two wrong decisions
+    assert run_metrics(log, sc)["decision_precision"] == pytest.approx(1 / 3)
 
 
 def test_gnn_tracker_gives_no_track_two_reports_in_a_scan():
@@ -312,27 +437,57 @@ def test_pinned_small_seeded_run():
     exp = repro.experiments(1, 0, SMALL, parts=("main",))[0]
     s = exp.settings[0]
     res = repro.trial(s, exp.methods, trial_seed(0, s, 0))
-    pinned = {"did": (35 / 44, 0, 1, 0.5, 2 / 97), "did-literal": (8 / 11, 0, 0, 0.5, 1.0),
-              "did-origin": (31 / 44, 0, 0, 1.0, 3 / 97), "did-q0": (1.0, 0, 0, 1.0, 2 / 97),
-              "gnn": (1.0, 0, 0, 1.0, None), "nn": (1.0, 0, 0, 1.0, None)}
-    for m, (rate, swaps, false, held, nonconv) in pinned.items():
+    # did-zm, did-zscore, did-movable and did-q0 were "did", "did-literal", "did-origin"
+    # and "did-q0" before the printed reading was added: same numbers
+    pinned = {"did-printed": (7 / 22, 0, 0, 0.25, 1.0, 13 / 15),
+              "did-dowhile": (4 / 11, 0, 0, 0.5, 1.0, 16 / 17),
+              "did-conflict-q0": (17 / 44, 0, 0, 0.5, 1.0, 16 / 17),
+              "did-conflict-new": (15 / 44, 0, 0, 0.25, 1.0, 7 / 8),
+              "did-zm": (35 / 44, 0, 1, 0.5, 2 / 97, 34 / 45),
+              "did-zscore": (8 / 11, 0, 0, 0.5, 1.0, 32 / 37),
+              "did-movable": (31 / 44, 0, 0, 1.0, 3 / 97, 5 / 6),
+              "did-q0": (1.0, 0, 0, 1.0, 2 / 97, 44 / 47),
+              "gnn": (1.0, 0, 0, 1.0, None, 1.0), "nn": (1.0, 0, 0, 1.0, None, 1.0)}
+    for m, (rate, swaps, false, held, nonconv, prec) in pinned.items():
         r = res[m]
         assert r["correct_rate"] == pytest.approx(rate), m
+        assert r["decision_precision"] == pytest.approx(prec), m
         assert (r["swaps"], r["false_tracks"], r["held_at_end"]) == (swaps, false, held), m
         assert r.get("nonconverged_rate") == (None if nonconv is None else pytest.approx(nonconv))
 
 
 def test_reproduction_writes_summary_figures_and_resumes(tmp_path):
     from assocopt.reproduce import xue1999 as repro
-    opts = {**SMALL, "noise_grid": (1.0, 2.0), "clutter_grid": (0.0,), "sweep_divisor": 1}
+    opts = {**SMALL, "noise_grid": (1.0, 2.0), "clutter_grid": (0.0,), "sweep_divisor": 1,
+            "main_methods": ("did-printed", "gnn"), "sweep_methods": ("did-printed", "nn"),
+            "tune_methods": ("did-printed", "did-q0"), "tune_B": (0.05, 0.2),
+            "tune_M_prime": (3.0, 6.0), "tune_divisor": 1}
     printed = []
     s = repro.run(2, 1, 3, tmp_path, options=opts, echo=printed.append)
     data = json.loads((tmp_path / "summary.json").read_text())
-    assert data["paper"] == "xue1999" and data["runs"] == 2
-    assert {r["experiment"] for r in data["records"]} == {"main", "sweep"}
+    assert data["paper"] == "xue1999" and data["runs"] == 2 and data["tune_runs"] == 2
+    assert {r["experiment"] for r in data["records"]} == {"tune", "main", "sweep"}
     assert all(r["runs"] == 2 for r in data["records"] if r["metric"] == "correct_rate")
     assert "did_scale" in data["parameters"]["ours"]["ours"]
-    assert "Base scene" in printed[0] and "Sweep: correct association rate" in printed[0]
+    # the tuning grid: every method at every pair; the best of each joins main and sweep
+    tune = {r["method"] for r in data["records"] if r["experiment"] == "tune"}
+    assert len(tune) == 2 * 2 * 2
+    assert data["tuned"] == repro.best_pairs(data["records"], opts)
+    main = {r["method"] for r in data["records"] if r["experiment"] == "main"}
+    sweep = {r["method"] for r in data["records"] if r["experiment"] == "sweep"}
+    best = {m: b["method"] for m, b in data["tuned"].items()}
+    at_best = {m + best["did-printed"][len("did-printed"):]
+               for m in repro.DEFAULTS["at_printed_best"]}
+    assert main == {"did-printed", "gnn", best["did-printed"], best["did-q0"]} | at_best
+    assert sweep == {"did-printed", "nn", best["did-printed"]}
+    rate = {r["method"]: r["value"] for r in data["records"]
+            if r["experiment"] == "tune" and r["metric"] == "correct_rate"}
+    for m, b in data["tuned"].items():
+        grid = [v for n, v in rate.items() if n.startswith(m + "@")]
+        assert b["correct_rate"] == max(grid) and b["range"] == [min(grid), max(grid)]
+    for part in ("Tuning: best (B, M′)", "Base scene", "Sweep: correct association rate",
+                 "Sweep: decision precision"):
+        assert part in printed[0], part
     for f in s["figures"]:
         assert (tmp_path / f).stat().st_size > 0
     again = repro.run(2, 1, 3, tmp_path, options=opts, echo=lambda t: None)
@@ -345,7 +500,7 @@ def test_reproduction_writes_summary_figures_and_resumes(tmp_path):
 @pytest.mark.slow
 def test_reproduction_same_numbers_with_two_workers(tmp_path):
     from assocopt.reproduce import xue1999 as repro
-    opts = {**SMALL, "n_scans": 8, "main_methods": ("did", "gnn")}
+    opts = {**SMALL, "n_scans": 8, "main_methods": ("did-printed", "gnn")}
     one = repro.run(3, 1, 5, tmp_path / "a", options=opts, parts=("main",), echo=lambda t: None)
     two = repro.run(3, 2, 5, tmp_path / "b", options=opts, parts=("main",), echo=lambda t: None)
     pick = lambda s: sorted((r["method"], r["metric"], r["value"]) for r in s["records"]
@@ -359,6 +514,10 @@ def test_reproduction_rejects_unknown_options_and_methods():
         repro.experiments(2, 0, {"bogus": 1})
     with pytest.raises(ValueError, match="unknown xue1999 method"):
         repro.experiments(2, 0, {"sweep_methods": ("jpda",)})
+    with pytest.raises(ValueError, match="not a DID method"):
+        repro.experiments(2, 0, {"tune_methods": ("gnn",)})
+    with pytest.raises(ValueError, match="tune_divisor"):
+        repro.experiments(2, 0, {"tune_divisor": 0})
 
 
 # ------------------------------------------------------------- the page
@@ -370,3 +529,14 @@ def test_page_tables_match_the_committed_summary():
     from assocopt.reproduce import xue1999 as repro
     summary = check_page_against_summary(repro, "xue1999", PAGE, SUMMARY)
     assert summary["runs"] == 200 and summary["seed"] == 0
+    text = PAGE.read_text(encoding="utf-8")
+    assert page_block(text, "example") == repro.render_example().strip()
+    # the tuning grid and its best pairs are in the summary, and the tuned methods were
+    # re-run in the main comparison and the sweep
+    assert summary["tuned"] == repro.best_pairs(summary["records"])
+    assert set(summary["tuned"]) == set(repro.DEFAULTS["tune_methods"])
+    tune = {r["method"] for r in summary["records"] if r["experiment"] == "tune"}
+    assert len(tune) == (len(repro.DEFAULTS["tune_methods"]) * len(repro.DEFAULTS["tune_B"])
+                         * len(repro.DEFAULTS["tune_M_prime"]))
+    main = {r["method"] for r in summary["records"] if r["experiment"] == "main"}
+    assert {b["method"] for b in summary["tuned"].values()} <= main

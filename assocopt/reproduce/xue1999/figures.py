@@ -7,18 +7,30 @@ from typing import Any, Mapping
 
 import numpy as np
 
-from ...tracking.scenarios.xue1999_tracker import METHODS, run_tracker
+from ...tracking.scenarios.xue1999_tracker import run_tracker, split_method
 from .._plot import draw_all, save
 from . import experiment as exp
-from .experiment import LABELS
-from .report import lookup
+from .experiment import label
+from .report import lookup, ordered
 
 __all__ = ["make_figures"]
 
 _COLOURS = ("tab:blue", "tab:orange", "tab:green", "tab:red")
-#: One colour per method in every figure.
-_METHOD_COLOURS = {"did": "tab:blue", "did-literal": "tab:orange", "did-origin": "tab:green",
-                   "did-q0": "tab:red", "gnn": "tab:purple", "nn": "tab:brown"}
+#: One colour per method in every figure (a tuned method: its base's, dashed).
+_METHOD_COLOURS = {"did-printed": "tab:blue", "did-dowhile": "tab:cyan",
+                   "did-zscore": "tab:orange", "did-movable": "tab:green",
+                   "did-printed-q0": "tab:olive", "did-majority": "gold",
+                   "did-conflict-q0": "tab:pink",
+                   "did-conflict-new": "tab:gray", "did-zm": "black", "did-q0": "tab:red",
+                   "gnn": "tab:purple", "nn": "tab:brown"}
+#: The methods of the per-scan figure (and their tuned versions).
+_PER_SCAN = ("did-printed", "did-dowhile", "did-majority", "did-zm", "did-q0", "gnn", "nn")
+
+
+def _style(m: str) -> dict:
+    base, over = split_method(m)
+    return {"color": _METHOD_COLOURS.get(base), "ls": "--" if over else "-",
+            "label": label(m)}
 
 
 def make_figures(summary: Mapping[str, Any], out, options: Mapping[str, Any]) -> list[str]:
@@ -31,7 +43,7 @@ def _scene(plt, summary, out, o) -> str | None:
     tp = exp._tracker(o)
     scans = sc.simulate(np.random.default_rng(int(o["example_seed"])))
     X = sc.truth()
-    methods = [m for m in ("did", "did-q0", "gnn") if m in METHODS]
+    methods = ["did-printed", "did-q0", "gnn"]
     fig, axes = plt.subplots(1, 1 + len(methods), figsize=(4.2 * (1 + len(methods)), 4.7),
                              sharex=True, sharey=True)
     ax = axes[0]
@@ -60,8 +72,8 @@ def _scene(plt, summary, out, o) -> str | None:
             own = log.owner[tid]
             ax.plot(p[:, 0], p[:, 1], "-", lw=0.9,
                     color=_COLOURS[own % 4] if own >= 0 else "k")
-        ax.set_title(f"confirmed tracks: {LABELS[m]}\n(like the paper's Fig. 3)",
-                     fontsize=9)
+        ax.set_title(f"confirmed tracks: {label(m)}\n(like the paper's Fig. 3)",
+                     fontsize=7)
     for ax in axes:
         ax.set_xlabel("x (km)")
         ax.set_aspect("equal")
@@ -78,15 +90,15 @@ def _per_scan(plt, summary, out, o) -> str | None:
             and r["metric"].startswith("car_k")]
     if not recs:
         return None
-    fig, ax = plt.subplots(figsize=(7, 4.2))
-    for m in METHODS:
+    fig, ax = plt.subplots(figsize=(8, 5))
+    for m in ordered({r["method"] for r in recs}):
+        if split_method(m)[0] not in _PER_SCAN:
+            continue
         rows = sorted((int(r["metric"][5:]), r["value"], r["stderr"] or 0.0)
                       for r in recs if r["method"] == m)
-        if not rows:
-            continue
         k, v, se = map(np.array, zip(*rows))
-        line, = ax.plot(k, v, "-", lw=1.2, label=LABELS[m], color=_METHOD_COLOURS.get(m))
-        ax.fill_between(k, v - 1.96 * se, v + 1.96 * se, color=line.get_color(), alpha=0.2)
+        line, = ax.plot(k, v, lw=1.2, **_style(m))
+        ax.fill_between(k, v - 1.96 * se, v + 1.96 * se, color=line.get_color(), alpha=0.15)
     for k in (20, 30):
         ax.axvline(k, color="0.5", ls=":", lw=0.8)
     runs = max(r["runs"] for r in recs)
@@ -96,7 +108,7 @@ def _per_scan(plt, summary, out, o) -> str | None:
                  fontsize=9)
     ax.set_ylim(0, 1.02)
     ax.grid(alpha=0.3)
-    ax.legend(fontsize=7, loc="lower left")
+    ax.legend(fontsize=6, loc="lower left")
     return save(fig, out, "fig_per_scan.png")
 
 
@@ -108,18 +120,18 @@ def _sweep(plt, summary, out, o) -> str | None:
     fig, axes = plt.subplots(1, len(clutter), figsize=(4 * len(clutter), 3.8), sharey=True)
     axes = np.atleast_1d(axes)
     for ax, c in zip(axes, clutter):
-        for m in METHODS:
+        for m in ordered({k[0] for k in tab}):
             pts = sorted((k[1], *v) for k, v in tab.items() if k[0] == m and k[2] == c)
             if not pts:
                 continue
             f, v, _, se = zip(*pts)
             ax.errorbar(f, v, yerr=1.96 * np.array([s or 0.0 for s in se]), marker="o",
-                        ms=3, capsize=2, label=LABELS[m], color=_METHOD_COLOURS.get(m))
+                        ms=3, capsize=2, **_style(m))
         ax.set_title(f"clutter mean {c:g} per scan", fontsize=9)
         ax.set_xlabel("noise scale (x sigma_p, sigma_v)")
         ax.grid(alpha=0.3)
     axes[0].set_ylabel("correct association rate")
-    axes[0].legend(fontsize=7)
+    axes[0].legend(fontsize=6)
     runs = max(v[1] for v in tab.values())
     fig.suptitle(f"where each method breaks ({runs} runs per point, 95 % CI)", fontsize=9)
     return save(fig, out, "fig_sweep.png", rect=(0, 0, 1, 0.93), bbox_inches="tight")

@@ -27,8 +27,12 @@ independently: repeatedly take the most ambiguous factor ``i*`` (smallest
 ``|s_on - 0.5|``) and move it by the others' evidence,
 ``s_on[i*] += sum_{l != i*} B[i*, l] (s_on[l] - s_off[l])``, ``s_off = 1 - s_on``,
 with states clipped to [0, 1] (the paper gives no clipping), until all the record's
-factors agree (all on or all off).  ``B`` is symmetric with entries in [0, 1] and a
-zero diagonal.  The loop is capped at ``max_iter`` updates (convergence is asserted in
+factors agree (all on or all off).  Step 5 ("重复第三步, 直到各关联因素一致",
+repeat step 3 until the factors agree) comes after one update (steps 3-4), so it
+reads as a while loop (``min_updates=0``: a record that already agrees is not
+moved) or as a do-while (``min_updates=1``: every record left in stage 2, even one
+already all on, gets at least one update); both are literal.  ``B`` is symmetric
+with entries in [0, 1] and a zero diagonal.  The loop is capped at ``max_iter`` updates (convergence is asserted in
 the paper, not shown); a record that does not settle is *not converged*, is reported
 as such and is not associated (``unresolved="reject"``) or is judged by the majority
 of its factors (``"majority"``).  With ``select="literal"`` the most ambiguous factor
@@ -41,6 +45,9 @@ score ``q_k = sum_i s_on[i, k]`` over all factors (ties: the lowest index), summ
 the states after stage 2 as printed (``score="final"``) or, as our variant, over the
 stage-1 states (``score="initial"``: stage 2 inflates the states it pushes to "on",
 so a contradictory record can outscore a consistent one).
+
+The rule as printed is ``error="origin"``, ``select="literal"``, ``score="final"``
+with ``min_updates`` 0 or 1; the defaults ``"scale"`` and ``"movable"`` are ours.
 
 Stage 1 is vectorised over reports and records; stage 2 runs every unsettled
 (report, record) column through one compiled (numba) loop.
@@ -98,6 +105,10 @@ class DIDParams:
     score : {"final", "initial"}
         States summed by the final score q: after stage 2 (as printed) or the
         stage-1 states (ours: stage 2 only decides which records are associated).
+    min_updates : int
+        Updates every stage-2 record gets before its agreement is checked: 0 reads
+        step 5 as a while loop, 1 as a do-while (both literal; see the module
+        docstring).
     """
 
     M: float = 1.0
@@ -107,6 +118,7 @@ class DIDParams:
     select: str = "movable"
     unresolved: str = "reject"
     score: str = "final"
+    min_updates: int = 0
 
     def __post_init__(self) -> None:
         if not (np.isfinite(self.M) and self.M > 0):
@@ -115,6 +127,9 @@ class DIDParams:
             raise ValueError(f"M_prime must be a finite number >= 1, got {self.M_prime!r}")
         if not isinstance(self.max_iter, (int, np.integer)) or self.max_iter < 0:
             raise ValueError(f"max_iter must be a non-negative integer, got {self.max_iter!r}")
+        if not isinstance(self.min_updates, (int, np.integer)) or self.min_updates < 0:
+            raise ValueError(f"min_updates must be a non-negative integer, "
+                             f"got {self.min_updates!r}")
         if self.select not in SELECTS:
             raise ValueError(f"select must be one of {SELECTS}, got {self.select!r}")
         if self.unresolved not in UNRESOLVED:
@@ -231,37 +246,38 @@ def stage1_case(s_on: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
 
 
 # ------------------------------------------------------------------ stage 2
-def stage2(s_on: ArrayLike, B: np.ndarray, max_iter: int, select: str = "movable"
-           ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+def stage2(s_on: ArrayLike, B: np.ndarray, max_iter: int, select: str = "movable",
+           min_updates: int = 0) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Run the stage-2 loop on independent columns.
 
-    ``s_on`` has shape (P, m): one row per (report, record) column.  Returns the
-    final states, whether each column settled (all factors agree) and its number of
-    updates.
+    ``s_on`` has shape (P, m): one row per (report, record) column.  The first
+    ``min_updates`` updates are made without checking agreement (do-while reading).
+    Returns the final states, whether each column settled (all factors agree) and
+    its number of updates.
     """
     s = np.array(s_on, dtype=np.float64)
     if s.ndim != 2:
         raise ValueError(f"stage-2 columns must have shape (P, m), got {s.shape}")
     iters = _stage2_kernel(s, np.ascontiguousarray(B, dtype=np.float64), int(max_iter),
-                           select == "movable")
+                           select == "movable", int(min_updates))
     on = dominance(s)
     settled = on.all(axis=1) | (~on).all(axis=1)
     return s, settled, iters
 
 
 @njit(cache=True)
-def _stage2_kernel(s, B, max_iter, movable):            # pragma: no cover - compiled
+def _stage2_kernel(s, B, max_iter, movable, min_updates):   # pragma: no cover - compiled
     """In place: the stage-2 loop of every column (row) of ``s``; returns the updates."""
     P, m = s.shape
     iters = np.zeros(P, np.int64)
     y = np.empty(m)
     for p in range(P):
-        for _ in range(max_iter):
+        for it in range(max_iter):
             n_on = 0
             for i in range(m):
                 if s[p, i] >= 1.0 - s[p, i]:
                     n_on += 1
-            if n_on == 0 or n_on == m:
+            if it >= min_updates and (n_on == 0 or n_on == m):
                 break                                   # the factors agree: settled
             for i in range(m):
                 acc = 0.0
@@ -329,7 +345,7 @@ def did_decide(s_on: ArrayLike, params: DIDParams) -> DIDResult:
         r_idx, k_idx = np.nonzero(keep)
         cols = S[amb[r_idx], :, k_idx]                            # (P, m)
         final, settled, it = stage2(cols, strength_matrix(params.B, m), params.max_iter,
-                                    params.select)
+                                    params.select, params.min_updates)
         S[amb[r_idx], :, k_idx] = final
         on_f = dominance(final)
         if params.unresolved == "reject":

@@ -18,9 +18,15 @@ The paper says neither how stored records are created nor how they are updated
   ``1 - gate_alpha``; pairs costing ``c_new`` or more are never used.
 * **DID**: stored records as columns, factors (x, y, vx, vy, IFF); the ``"scale"``
   reading divides each kinematic difference by that factor's innovation standard
-  deviation ``sqrt(S_ii)``.  When several reports choose one track, the track keeps
-  the report with the largest score q and the others are dropped (they were judged
-  to belong to a known target, not to be new ones).
+  deviation ``sqrt(S_ii)``.  The paper decides one report at a time and says nothing
+  about several reports of one scan choosing the same record; the rule
+  (``conflict``, not from the paper) is one of :data:`CONFLICTS`: ``"q_final"``
+  (the track keeps the report with the largest printed score q, the others are
+  dropped: they were judged to belong to a known target), ``"q_initial"`` (the same
+  ranked by the stage-1 q) or ``"new_track"`` (largest printed q kept, the others
+  start new tracks).
+* **Methods**: the keys of :data:`METHODS`, or ``"NAME@B=0.05,Mp=3"`` with DID's B
+  and M' set (:func:`tuned_name`; the reproduction's tuning).
 
 >>> from assocopt.tracking.scenarios.xue1999 import Xue1999
 >>> sc = Xue1999(clutter_mean=0.0, p_d=1.0)
@@ -33,7 +39,8 @@ The paper says neither how stored records are created nor how they are updated
 from __future__ import annotations
 
 import math
-from dataclasses import asdict, dataclass, field
+import re
+from dataclasses import asdict, dataclass, field, replace
 from typing import Any
 
 import numpy as np
@@ -43,18 +50,56 @@ from ..decide.did import DIDParams, did_decide, initial_states, relative_errors
 from ..decide.nearest import gnn_assign, nearest_neighbour
 from .xue1999 import Scan, Xue1999
 
-__all__ = ["TrackerParams", "METHODS", "RunLog", "run_tracker", "run_metrics",
-           "association_costs"]
+__all__ = ["TrackerParams", "METHODS", "CONFLICTS", "RunLog", "run_tracker", "run_metrics",
+           "association_costs", "method_options", "tuned_name", "split_method"]
 
-#: Association methods: name -> options (``rule`` did / gnn / nn; DID options).
+#: Rules for several reports of one scan choosing one track (none is the paper's).
+CONFLICTS = ("q_final", "q_initial", "new_track")
+
+_PRINTED = {"rule": "did", "error": "origin", "select": "literal", "score": "final",
+            "min_updates": 0, "conflict": "q_final", "unresolved": "reject"}
+#: Association methods: name -> options (``rule`` did / gnn / nn; DID options).  The
+#: DID methods are the printed rule (eq. (10) with the literal selection; step 5 as a
+#: while or a do-while loop) and the printed rule with our changes.
 METHODS: dict[str, dict[str, Any]] = {
-    "did": {"rule": "did", "error": "scale", "select": "movable"},
-    "did-literal": {"rule": "did", "error": "scale", "select": "literal"},
-    "did-origin": {"rule": "did", "error": "origin", "select": "movable"},
-    "did-q0": {"rule": "did", "error": "scale", "select": "movable", "score": "initial"},
+    "did-printed": dict(_PRINTED),
+    "did-dowhile": {**_PRINTED, "min_updates": 1},
+    "did-zscore": {**_PRINTED, "error": "scale"},
+    "did-movable": {**_PRINTED, "select": "movable"},
+    "did-printed-q0": {**_PRINTED, "score": "initial"},
+    "did-majority": {**_PRINTED, "unresolved": "majority"},
+    "did-conflict-q0": {**_PRINTED, "conflict": "q_initial"},
+    "did-conflict-new": {**_PRINTED, "conflict": "new_track"},
+    "did-zm": {**_PRINTED, "error": "scale", "select": "movable"},
+    "did-q0": {**_PRINTED, "error": "scale", "select": "movable", "score": "initial"},
     "gnn": {"rule": "gnn"},
     "nn": {"rule": "nn"},
 }
+
+_TUNED = re.compile(r"^(?P<base>[\w-]+)@B=(?P<B>[0-9.e+-]+),Mp=(?P<Mp>[0-9.e+-]+)$")
+
+
+def tuned_name(base: str, B: float, M_prime: float) -> str:
+    """The method ``base`` with DID's B and M' set: ``"did-printed@B=0.05,Mp=3"``."""
+    if base not in METHODS or METHODS[base]["rule"] != "did":
+        raise ValueError(f"{base!r} is not a DID method of METHODS")
+    return f"{base}@B={float(B):g},Mp={float(M_prime):g}"
+
+
+def split_method(name: str) -> tuple[str, dict[str, float]]:
+    """``(base, {"did_B": B, "did_M_prime": M'})`` of a method name (``{}``: no override)."""
+    m = _TUNED.match(name)
+    base, over = (m["base"], {"did_B": float(m["B"]), "did_M_prime": float(m["Mp"])}) \
+        if m else (name, {})
+    if base not in METHODS or (over and METHODS[base]["rule"] != "did"):
+        raise ValueError(f"unknown method {name!r}; valid: {sorted(METHODS)}, or a DID "
+                         "method as NAME@B=<B>,Mp=<M'>")
+    return base, over
+
+
+def method_options(name: str) -> dict[str, Any]:
+    """The options of a method name (a key of :data:`METHODS`, or one with B, M' set)."""
+    return METHODS[split_method(name)[0]]
 
 
 @dataclass(frozen=True)
@@ -87,7 +132,8 @@ class TrackerParams:
         M = self.did_origin_M if opts["error"] == "origin" else self.did_M
         return DIDParams(M=M, M_prime=self.did_M_prime, B=self.did_B,
                          max_iter=self.did_max_iter, select=opts["select"],
-                         score=opts.get("score", "final"))
+                         score=opts.get("score", "final"), min_updates=opts.get("min_updates", 0),
+                         unresolved=opts.get("unresolved", "reject"))
 
     def as_dict(self) -> dict[str, Any]:
         d = asdict(self)
@@ -124,7 +170,7 @@ class RunLog:
     sources: dict = field(default_factory=dict)
     path: dict = field(default_factory=dict)           # id -> [(k, x, y)]
     did_stats: dict = field(default_factory=lambda: {"decisions": 0, "stage2": 0,
-                                                     "nonconverged": 0})
+                                                     "nonconverged": 0, "conflicts": 0})
 
 
 def _cv_model(T: float, q: float) -> tuple[np.ndarray, np.ndarray]:
@@ -144,10 +190,9 @@ def association_costs(z: np.ndarray, z_iff: np.ndarray, x: np.ndarray, S: np.nda
     return d2 + iff_cost * (z_iff[:, None] != t_iff[None, :])
 
 
-def _associate(method: str, z, z_iff, x, S, t_iff, sc: Xue1999, p: TrackerParams,
+def _associate(opts: dict[str, Any], z, z_iff, x, S, t_iff, sc: Xue1999, p: TrackerParams,
                log: RunLog) -> tuple[list[tuple[int, int]], np.ndarray]:
     """(report, track) pairs and the mask of reports that start new tracks."""
-    opts = METHODS[method]
     R, n = len(z), len(x)
     if n == 0:
         return [], np.ones(R, dtype=bool)
@@ -173,24 +218,43 @@ def _associate(method: str, z, z_iff, x, S, t_iff, sc: Xue1999, p: TrackerParams
         delta = relative_errors(factors, records, error="origin",
                                 floor=np.asarray(p.did_origin_floor, dtype=np.float64),
                                 categorical=[False] * 4 + [True])
-    res = did_decide(initial_states(delta, dp), dp)
+    s0 = initial_states(delta, dp)
+    res = did_decide(s0, dp)
     log.did_stats["decisions"] += R
     log.did_stats["stage2"] += int((res.stage == 2).sum())
     log.did_stats["nonconverged"] += int((~res.converged).sum())
+    return _settle_conflicts(res.choice, res.score, s0, opts.get("conflict", "q_final"), log)
+
+
+def _settle_conflicts(choice: np.ndarray, score: np.ndarray, s0: np.ndarray, rule: str,
+                      log: RunLog) -> tuple[list[tuple[int, int]], np.ndarray]:
+    """One report per track (rule of :data:`CONFLICTS`): the pairs and the reports that
+    start new tracks."""
+    if rule not in CONFLICTS:
+        raise ValueError(f"conflict must be one of {CONFLICTS}, got {rule!r}")
+    q = np.nan_to_num(score, nan=-np.inf)
+    if rule == "q_initial":
+        k = np.maximum(choice, 0)
+        q = np.where(choice >= 0, s0[np.arange(len(choice)), :, k].sum(axis=1), -np.inf)
     best: dict[int, int] = {}                 # track -> the report with the largest q
-    for r in np.argsort(-np.nan_to_num(res.score, nan=-np.inf), kind="stable"):
-        j = int(res.choice[r])
+    initiate = choice < 0
+    for r in np.argsort(-q, kind="stable"):
+        j = int(choice[r])
         if j >= 0 and j not in best:
             best[j] = int(r)
-    return sorted((r, j) for j, r in best.items()), res.choice < 0
+        elif j >= 0:
+            log.did_stats["conflicts"] += 1
+            initiate[r] = rule == "new_track"
+    return sorted((r, j) for j, r in best.items()), initiate
 
 
 def run_tracker(scans: list[Scan], method: str, sc: Xue1999,
                 params: TrackerParams | None = None) -> RunLog:
-    """Track one simulated run with ``method`` (a key of :data:`METHODS`)."""
-    if method not in METHODS:
-        raise ValueError(f"unknown method {method!r}; valid: {sorted(METHODS)}")
-    p = params or TrackerParams()
+    """Track one simulated run with ``method`` (a key of :data:`METHODS`, or one with
+    DID's B and M' set, see :func:`tuned_name`)."""
+    base, over = split_method(method)
+    opts = METHODS[base]
+    p = replace(params or TrackerParams(), **over)
     F, Q = _cv_model(sc.T, p.q)
     Rm = np.diag(sc.sigma ** 2)
     tr = _Tracks(np.zeros((0, 4)), np.zeros((0, 4, 4)))
@@ -202,7 +266,7 @@ def run_tracker(scans: list[Scan], method: str, sc: Xue1999,
             tr.x = tr.x @ F.T
             tr.P = F @ tr.P @ F.T + Q
         S = tr.P + Rm
-        pairs, initiate = _associate(method, scan.reports, scan.iff, tr.x, S, tr.iff(),
+        pairs, initiate = _associate(opts, scan.reports, scan.iff, tr.x, S, tr.iff(),
                                      sc, p, log)
         went: list[list[int]] = [[] for _ in range(len(scan.source))]
         hit = np.zeros(len(tr.ids), dtype=bool)
@@ -273,7 +337,14 @@ def run_metrics(log: RunLog, sc: Xue1999) -> dict[str, float]:
     of true target along the reports of every once-confirmed track (clutter reports
     skipped).  ``false_tracks``: once-confirmed tracks with a majority of clutter
     reports.  ``held_at_end``: fraction of targets whose report last fed a live,
-    confirmed track started by that target.
+    confirmed track started by that target.  ``decision_precision``: over every
+    association of a report with an existing track, the fraction where the report
+    came from the target of the track's previous report (a clutter report, or a
+    track whose previous report was clutter, counts as wrong): a swap is one wrong
+    decision here, while ``correct_rate`` counts every later report of the swapped
+    targets as wrong.  DID only: ``stage2_rate``, ``nonconverged_rate`` and
+    ``conflict_rate`` (reports that lost a track to another report of the scan), per
+    report.
     """
     out: dict[str, float] = {}
     tot_ok = tot_n = 0
@@ -295,8 +366,10 @@ def run_metrics(log: RunLog, sc: Xue1999) -> dict[str, float]:
         tot_ok += ok
         tot_n += n
     out["correct_rate"] = tot_ok / tot_n if tot_n else math.nan
-    swaps = false = 0
+    swaps = false = dec = dec_ok = 0
     for tid, srcs in log.sources.items():
+        dec += len(srcs) - 1
+        dec_ok += sum(b >= 0 and a == b for a, b in zip(srcs, srcs[1:]))
         if not log.confirmed.get(tid):
             continue
         tgt = [s for s in srcs if s >= 0]
@@ -305,10 +378,12 @@ def run_metrics(log: RunLog, sc: Xue1999) -> dict[str, float]:
     out["swaps"] = float(swaps)
     out["false_tracks"] = float(false)
     out["held_at_end"] = _held_at_end(log, sc)
+    out["decision_precision"] = dec_ok / dec if dec else math.nan
     d = log.did_stats
     if d["decisions"]:
         out["stage2_rate"] = d["stage2"] / d["decisions"]
         out["nonconverged_rate"] = d["nonconverged"] / d["decisions"]
+        out["conflict_rate"] = d["conflicts"] / d["decisions"]
     return out
 
 
