@@ -339,7 +339,8 @@ class TestUserPaths:
                 time.sleep(delay)
                 proc.send_signal(signal.SIGTERM)
                 _, err = proc.communicate(timeout=120)
-            assert proc.returncode in (0, 130, -signal.SIGTERM, -signal.SIGINT), err
+            assert proc.returncode in (0, 130, -signal.SIGTERM, -signal.SIGINT), \
+                (proc.returncode, err)
             leftovers = [p.name for p in out_dir.iterdir() if p.name.startswith(".")]
             assert leftovers == [], leftovers
 
