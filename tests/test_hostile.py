@@ -415,9 +415,9 @@ class TestTimeLimits:
 
         monkeypatch.setattr(scipy.optimize, "milp", spy)
         small = AssignmentProblem.dense(np.arange(9.0).reshape(3, 3))
-        solve(small, "scipy", time_limit=5.0)
+        solve(small, "scipy", time_limit=5.0, isolate=False)    # spied in this process
         solve(small, "scipy")
-        solve(small, "scipy", time_limit=5.0, presolve=True)
+        solve(small, "scipy", time_limit=5.0, presolve=True, isolate=False)
         assert seen[0]["presolve"] is False and "presolve" not in seen[1]
         assert seen[2]["presolve"] is True
         assert solve(small, "highs", time_limit=5.0).info["presolve"] == "off"

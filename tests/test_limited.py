@@ -1,0 +1,84 @@
+"""Time limits that hold: under a limit, HiGHS and scipy's milp solve in a child
+process (``assocopt.solvers.limited``) that is killed at the deadline or on Ctrl-C.
+
+No wall-clock assertions: a killed child is recognised by ``info["isolated"]`` and the
+autouse fixture of conftest.py checks that no child process outlives its test.
+"""
+
+from __future__ import annotations
+
+import _thread
+import threading
+
+import numpy as np
+import pytest
+
+from assocopt import AssignmentProblem, solve
+from assocopt.errors import InvalidProblemError
+from assocopt.generate import generate_dense
+from assocopt.solution import Status
+from assocopt.solvers import limited, registered
+
+ISOLATED = [n for n in ("highs", "scipy") if registered()[n].is_available()]
+
+
+@pytest.fixture(scope="module")
+def hard():
+    """Dense 3-D n = 30: far more than half a second for HiGHS under a limit."""
+    return generate_dense(np.random.default_rng(5), (30, 30, 30), low=1000, high=2000)
+
+
+@pytest.mark.parametrize("relax", [None, "lp"])
+@pytest.mark.parametrize("solver", ISOLATED)
+def test_the_child_gives_the_same_answer(solver, relax):
+    p = AssignmentProblem.dense(np.random.default_rng(1).random((4, 4, 4)))
+    inside = solve(p, solver, relax=relax, time_limit=60.0, isolate=False)
+    child = solve(p, solver, relax=relax, time_limit=60.0)
+    assert "isolated" not in inside.info and isinstance(child.info["isolated"], float)
+    assert child.status is inside.status is Status.OPTIMAL
+    assert child.objective == pytest.approx(inside.objective)
+    if relax is None:
+        assert sorted(map(tuple, child.tuples)) == sorted(map(tuple, inside.tuples))
+    else:
+        np.testing.assert_allclose(child.x, inside.x, atol=1e-9)
+
+
+@pytest.mark.parametrize("solver", ISOLATED)
+def test_no_child_without_a_limit(solver):
+    p = AssignmentProblem.dense(np.random.default_rng(1).random((3, 3)))
+    assert "isolated" not in solve(p, solver).info
+
+
+@pytest.mark.parametrize("solver", ISOLATED)
+def test_a_child_still_running_at_the_deadline_is_killed(solver, hard, monkeypatch):
+    """The kill deadline moved to half a second after the start, far before the
+    solver's own limit: the child is killed and the run reports time_limit."""
+    monkeypatch.setattr(limited, "kill_slack", lambda limit: 0.5 - limit)
+    sol = solve(hard, solver, time_limit=60.0)
+    assert sol.info["isolated"] == "killed"
+    assert sol.status is Status.TIME_LIMIT and not sol.has_solution
+    assert "time limit" in sol.message
+
+
+@pytest.mark.parametrize("solver", ISOLATED)
+def test_ctrl_c_kills_the_child(solver, hard, sigint_python):
+    timer = threading.Timer(0.5, _thread.interrupt_main)
+    timer.start()
+    try:
+        with pytest.raises(KeyboardInterrupt):
+            solve(hard, solver, time_limit=600.0)
+    finally:
+        timer.cancel()
+
+
+def test_an_error_in_the_child_is_raised_here():
+    p = AssignmentProblem.dense(np.random.default_rng(1).random((3, 3)))
+    if "highs" not in ISOLATED:
+        pytest.skip("highspy not installed")
+    with pytest.raises(InvalidProblemError, match="mip_heuristic_effort"):
+        solve(p, "highs", time_limit=60.0, mip_heuristic_effort="lots")
+
+
+def test_kill_slack_fits_the_tolerance():
+    for limit in (0.1, 1.0, 10.0, 100.0):
+        assert 0 < limit.__class__(limited.kill_slack(limit)) < max(1.0, 0.1 * limit)
