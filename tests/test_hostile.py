@@ -541,6 +541,7 @@ class TestDistributed:
         a, b = _trial_numbers(local), _trial_numbers(remote)
         assert a and a == b
 
+    @pytest.mark.fixture_children
     def test_killed_worker_loses_no_trial(self, dask_cluster, tmp_path):
         from assocopt.experiments import Experiment, ResultStore, _demo_trial, run_experiment
 

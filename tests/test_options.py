@@ -66,7 +66,7 @@ def test_bad_value_names_solver_option_and_value():
 def test_native_options_pass_through_and_unknown_names_do_not():
     p = AssignmentProblem.dense(np.array([[4.0, 1.0], [2.0, 3.0]]))
     sol = solve(p, "highs", presolve="off")
-    assert sol.objective == 3.0 and sol.info["options"] == {"presolve": "off"}
+    assert sol.objective == 3.0 and sol.info["options"] == {"presolve": "off", "isolate": None}
     with pytest.raises(OptionError, match="it also takes any HiGHS option by name"):
         solve(p, "highs", presolv="off")
     if get_backend("ortools-cpsat").is_available():
