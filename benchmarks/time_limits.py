@@ -40,7 +40,7 @@ from assocopt.solvers import registered  # noqa: E402
 PAGE = ROOT / "docs" / "benchmarks-limits.md"
 DATA = ROOT / "docs" / "benchmarks-limits.json"
 GRUNDEL = ROOT.parent / "shared" / "ap_instances" / "grundel_ap3" / "ap3.50.1.txt"
-ISOLATING = ("highs", "scipy")
+ISOLATING = ("highs", "scipy", "cvxpy")
 
 
 def tolerance(limit: float) -> float:
@@ -144,10 +144,9 @@ def render(js: dict[str, Any]) -> str:
 
 def write_page(js: dict[str, Any]) -> None:
     text = PAGE.read_text()
-    begin, end = "<!-- limits:begin -->\n", "\n<!-- limits:end -->"
-    head, rest = text.split(begin)
-    _, tail = rest.split(end)
-    PAGE.write_text(head + begin + render(js) + end + tail)
+    head, rest = text.split("<!-- limits:begin -->")
+    _, tail = rest.split("<!-- limits:end -->")
+    PAGE.write_text(f"{head}<!-- limits:begin -->\n{render(js)}\n<!-- limits:end -->{tail}")
 
 
 def main(argv: list[str] | None = None) -> int:

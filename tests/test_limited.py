@@ -1,4 +1,4 @@
-"""Time limits that hold: under a limit, HiGHS and scipy's milp solve in a child
+"""Time limits that hold: under a limit, HiGHS, scipy's milp and cvxpy solve in a child
 process (``assocopt.solvers.limited``) that is killed at the deadline or on Ctrl-C.
 
 No wall-clock assertions: a killed child is recognised by ``info["isolated"]`` and the
@@ -19,7 +19,7 @@ from assocopt.generate import generate_dense
 from assocopt.solution import Status
 from assocopt.solvers import limited, registered
 
-ISOLATED = [n for n in ("highs", "scipy") if registered()[n].is_available()]
+ISOLATED = [n for n in ("highs", "scipy", "cvxpy") if registered()[n].is_available()]
 
 
 @pytest.fixture(scope="module")

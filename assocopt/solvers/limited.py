@@ -1,9 +1,10 @@
 """Time limits that hold: a solve under a limit in a child process that can be ended.
 
-HiGHS (through highspy or scipy's ``milp``) does not look at the clock in some phases
-(the root LP, cut rounds, symmetry detection): under load a 0.5 s limit was overshot
-to 3-5 s, and scipy's ``milp`` has no hook to stop it at all, so an abandoned solve kept
-a thread busy until it ended.  Under a time limit these back ends therefore run their
+HiGHS (through highspy, scipy's ``milp`` or cvxpy) does not look at the clock in some
+phases (the root LP, cut rounds, symmetry detection): under load a 0.5 s limit was
+overshot to 3-5 s, cvxpy's compilation knows no clock at all, and scipy and cvxpy have
+no hook to stop a solve, so an abandoned one kept a thread busy until it ended.  Under
+a time limit these back ends (``highs``, ``scipy``, ``cvxpy``) therefore run their
 solve in a child interpreter (``isolate`` option, on by default only when a limit is
 given): the model goes to it in bulk (one pickle of its arrays through a pipe), the
 child solves with the library's own limit and sends back what it found, and the parent
