@@ -10,7 +10,7 @@ tolerance max(1 s, 10 % of L).  HiGHS and scipy's milp run in a child process un
 limit (``isolate``, :mod:`assocopt.solvers.limited`); they are also run in this
 process (``isolate=False``) for comparison.  The start-up cost of the child (seconds
 from spawn until it has imported the solver and read the model) is measured on a
-3x3x3 problem with the cores idle (best and median of ``--rounds``), and recorded
+3x3x3 problem without the spinning processes (best and median of ``--rounds``), and recorded
 for every isolated run above.  The instance is ``ap3.50.1`` from ``../shared/
 ap_instances`` (the public Grundel set), or, without it, the tests' hard50 (dense
 3-D n = 50, costs 1000..2000, seed 5).
@@ -48,10 +48,10 @@ def tolerance(limit: float) -> float:
     return max(1.0, 0.1 * limit)
 
 
-def instance() -> tuple[str, AssignmentProblem]:
-    if GRUNDEL.is_file():
+def instance(path: Path = GRUNDEL) -> tuple[str, AssignmentProblem]:
+    if path.is_file():
         from assocopt.io import read_instance
-        return "Grundel ap3.50.1", read_instance(GRUNDEL)
+        return f"Grundel {path.stem}", read_instance(path)
     from assocopt.generate import generate_dense
     return "hard50 (dense 3-D n = 50, seed 5)", generate_dense(
         np.random.default_rng(5), (50, 50, 50), low=1000, high=2000)
@@ -93,11 +93,13 @@ def startup(rounds: int) -> dict[str, dict[str, float]]:
     return out
 
 
-def measure(limits: list[float], n_busy: int, rounds: int) -> dict[str, Any]:
-    label, problem = instance()
+def measure(limits: list[float], n_busy: int, rounds: int,
+            path: Path = GRUNDEL) -> dict[str, Any]:
+    label, problem = instance(path)
     names = sorted(n for n, c in registered().items()
                    if c.supports_time_limit and c.is_available())
     solve(AssignmentProblem.dense(np.ones((3, 3, 3))), "bnb")     # compile outside timing
+    load_startup = round(os.getloadavg()[0], 2)
     idle = startup(rounds)
     runs = []
     spinners = busy(n_busy)
@@ -117,8 +119,16 @@ def measure(limits: list[float], n_busy: int, rounds: int) -> dict[str, Any]:
     return {"instance": label, "limits": limits, "busy": n_busy, "cpus": os.cpu_count(),
             "load_start": [round(x, 2) for x in load], "load_end":
             [round(x, 2) for x in load_end], "python": platform.python_version(),
-            "startup_idle": idle, "runs": runs,
+            "startup_idle": idle, "load_startup": load_startup, "runs": runs,
             "command": "python benchmarks/time_limits.py"}
+
+
+def startup_sentence(js: dict[str, Any]) -> str:
+    """The child's start-up in words, as the README and the guide quote it."""
+    parts = [f"{s['median']:.1f} s for `{name}`" for name, s in js["startup_idle"].items()]
+    return "about " + ", ".join(parts) + f" (median of the rounds on {js['cpus']} cores at " \
+        f"load average {js.get('load_startup', '?')}: an upper bound; " \
+        "`benchmarks/time_limits.py`)"
 
 
 def render(js: dict[str, Any]) -> str:
@@ -135,8 +145,9 @@ def render(js: dict[str, Any]) -> str:
         lines.append(f"| `{r['solver']}` | {r['limit']:g} | {where} | {r['wall']:.2f} | "
                      f"{r['overshoot']:+.2f} | {'yes' if r['within'] else '**no**'} | "
                      f"{r['status']} | {ready} |")
-    lines += ["", "Start-up of the child process (3x3x3 problem, idle cores, best / "
-              "median of the rounds):", ""]
+    lines += ["", "Start-up of the child process (3x3x3 problem, no spinning processes, "
+              f"load average {js.get('load_startup', '?')}; best / median of the rounds):",
+              ""]
     for name, s in js["startup_idle"].items():
         lines.append(f"* `{name}`: {s['best']:.2f} s / {s['median']:.2f} s")
     return "\n".join(lines)
@@ -155,9 +166,13 @@ def main(argv: list[str] | None = None) -> int:
     ap.add_argument("--busy", type=int, default=os.cpu_count() or 2,
                     help="spinning processes (default: one per core)")
     ap.add_argument("--rounds", type=int, default=5, help="start-up measurements")
+    ap.add_argument("--instance", type=Path, default=GRUNDEL,
+                    help="Grundel file (default: ../shared/ap_instances/grundel_ap3/"
+                         "ap3.50.1.txt beside the checkout)")
     ap.add_argument("--no-write", action="store_true")
     args = ap.parse_args(argv)
-    js = measure([float(x) for x in args.limits.split(",")], args.busy, args.rounds)
+    js = measure([float(x) for x in args.limits.split(",")], args.busy, args.rounds,
+                 args.instance)
     print(render(js))
     if not args.no_write:
         DATA.write_text(json.dumps(js, indent=1) + "\n")

@@ -82,3 +82,23 @@ def test_an_error_in_the_child_is_raised_here():
 def test_kill_slack_fits_the_tolerance():
     for limit in (0.1, 1.0, 10.0, 100.0):
         assert 0 < limit.__class__(limited.kill_slack(limit)) < max(1.0, 0.1 * limit)
+
+
+def test_limits_page_and_docs_agree_with_the_committed_run():
+    """docs/benchmarks-limits.md is what benchmarks/time_limits.py renders from its
+    committed JSON, and the README and the guide quote its start-up figures."""
+    import json
+    from pathlib import Path
+
+    from conftest import load_script, page_block
+
+    root = Path(__file__).resolve().parents[1]
+    bench = load_script("benchmarks/time_limits.py", "bench_time_limits")
+    js = json.loads((root / "docs" / "benchmarks-limits.json").read_text())
+    page = (root / "docs" / "benchmarks-limits.md").read_text()
+    assert page_block(page, "limits") == bench.render(js).strip()
+    sentence = bench.startup_sentence(js)
+    for doc in ("README.md", "docs/guide.md"):
+        text = " ".join((root / doc).read_text().split())
+        assert sentence in text, doc
+    assert {r["solver"] for r in js["runs"]} >= set(ISOLATED)
