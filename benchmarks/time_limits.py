@@ -5,7 +5,8 @@ with every core kept busy by spinning processes.
     python benchmarks/time_limits.py --limits 1 --no-write
 
 For each back end and limit: the wall time of ``solve(problem, name, time_limit=L)``
-(building the model included), its overshoot past ``L`` and whether it is within the
+(building the model included; each back end's package imported beforehand, as in a
+program that already uses it), its overshoot past ``L`` and whether it is within the
 tolerance max(1 s, 10 % of L).  HiGHS and scipy's milp run in a child process under a
 limit (``isolate``, :mod:`assocopt.solvers.limited`); they are also run in this
 process (``isolate=False``) for comparison.  The start-up cost of the child (seconds
@@ -58,9 +59,10 @@ def instance(path: Path = GRUNDEL) -> tuple[str, AssignmentProblem]:
 
 
 def busy(n: int) -> list[subprocess.Popen]:
-    """``n`` processes spinning on a core each (ended by :func:`stop`)."""
-    return [subprocess.Popen([sys.executable, "-c", "while True: pass"])
-            for _ in range(n)]
+    """``n`` processes spinning on a core each (ended by :func:`stop`, or when this
+    process dies: they spin while their parent is this one)."""
+    code = f"import os\nwhile os.getppid() == {os.getpid()}: pass"
+    return [subprocess.Popen([sys.executable, "-c", code]) for _ in range(n)]
 
 
 def stop(procs: list[subprocess.Popen]) -> None:
@@ -98,7 +100,9 @@ def measure(limits: list[float], n_busy: int, rounds: int,
     label, problem = instance(path)
     names = sorted(n for n, c in registered().items()
                    if c.supports_time_limit and c.is_available())
-    solve(AssignmentProblem.dense(np.ones((3, 3, 3))), "bnb")     # compile outside timing
+    tiny = AssignmentProblem.dense(np.ones((3, 3, 3)))
+    for name in names:              # imports (and bnb's compilation) outside the timing
+        solve(tiny, name)
     load_startup = round(os.getloadavg()[0], 2)
     idle = startup(rounds)
     runs = []

@@ -102,3 +102,42 @@ def test_limits_page_and_docs_agree_with_the_committed_run():
         text = " ".join((root / doc).read_text().split())
         assert sentence in text, doc
     assert {r["solver"] for r in js["runs"]} >= set(ISOLATED)
+
+
+def test_the_child_exits_when_its_parent_is_killed(hard, tmp_path):
+    """SIGKILL of a process solving under a limit: its solver child notices (it watches
+    its parent, assocopt.parent_watch) and exits."""
+    import os
+    import subprocess
+    import sys
+    import time
+    from pathlib import Path
+
+    import psutil
+
+    from assocopt.io import write_instance
+    from processes import started
+
+    if "highs" not in ISOLATED:
+        pytest.skip("highspy not installed")
+    path = tmp_path / "hard.json"
+    write_instance(hard, path)
+    root = Path(__file__).resolve().parents[1]
+    code = ("import sys; from assocopt import solve; from assocopt.io import read_instance; "
+            "p = read_instance(sys.argv[1]); print('ready', flush=True); "
+            "solve(p, 'highs', time_limit=600.0)")
+    env = dict(os.environ, PYTHONPATH=str(root))
+    with started([sys.executable, "-c", code, path], env=env, text=True,
+                 stdout=subprocess.PIPE) as proc:
+        assert proc.stdout.readline().strip() == "ready"
+        kids: list[psutil.Process] = []
+        for _ in range(1200):                 # until the solver's child is up
+            kids = psutil.Process(proc.pid).children()
+            if kids or proc.poll() is not None:
+                break
+            time.sleep(0.05)
+        assert kids, "no solver child process started"
+        proc.kill()
+        proc.wait()
+        _, alive = psutil.wait_procs(kids, timeout=60)
+        assert alive == [], "the solver's child outlived its killed parent"
