@@ -18,8 +18,8 @@ import sys, time
 from assocopt.cli import watchdog
 watchdog.GRACE = 0.3
 watchdog.arm(130)
-print("ready", flush=True)
-try:
+try:                          # "ready" inside: the interrupt may come at once
+    print("ready", flush=True)
     time.sleep(30)
 except KeyboardInterrupt:
     pass                      # the interrupt lost, as in a finaliser
