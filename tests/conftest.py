@@ -2,10 +2,12 @@
 small random S-D problems the Lagrangian and branch-and-bound tests draw, the
 check that a paper page's generated blocks match its committed summary (and the rerun
 of one of its cells), loading the repository's scripts (benchmarks/, docs/) as
-modules, and running code in a fresh interpreter (import checks)."""
+modules, running code in a fresh interpreter (import checks), and the check that no
+child process outlives its test (helpers in ``processes.py``)."""
 
 from __future__ import annotations
 
+import faulthandler
 import importlib.util
 import json
 import os
@@ -21,6 +23,7 @@ from hypothesis import strategies as st
 from assocopt import AssignmentProblem
 from assocopt.solvers import registered
 from assocopt.testing import draw_costs, draw_sd
+from processes import children_now, kill_tree, leftover_children, sigint_handled
 
 ROOT = Path(__file__).resolve().parents[1]
 #: ../shared/ap_instances beside the project checkout (absent for installed users).
@@ -37,6 +40,62 @@ def installed(name: str):
     cls = registered()[name]
     return pytest.param(name, id=name, marks=pytest.mark.skipif(
         not cls.is_available(), reason=f"{cls.distribution} not installed"))
+
+
+#: Seconds a child may take to end after its test (a killed child being reaped).
+CHILD_GRACE = 5.0
+
+
+#: Seconds beyond pytest-timeout's limit after which a test stuck in C code (where
+#: SIGALRM cannot raise) ends the run with the tracebacks of all threads (the
+#: environment variable ASSOCOPT_TEST_BACKSTOP sets it, to check the backstop).
+BACKSTOP = 60.0 if "ASSOCOPT_TEST_BACKSTOP" not in os.environ else \
+    float(os.environ["ASSOCOPT_TEST_BACKSTOP"])
+
+
+def _timeout(config: pytest.Config) -> float:
+    try:
+        return float(config.getini("timeout") or 0)
+    except (ValueError, TypeError):          # pytest-timeout not installed
+        return 0.0
+
+
+def _stderr_fd(config: pytest.Config) -> int:
+    """The real standard error (pytest's copy of it, as its own faulthandler uses)."""
+    try:
+        from _pytest.faulthandler import fault_handler_stderr_fd_key
+        return config.stash[fault_handler_stderr_fd_key]
+    except (ImportError, KeyError):
+        return sys.__stderr__.fileno()
+
+
+@pytest.fixture(autouse=True)
+def no_process_left_behind(request):
+    """Fail (and kill) any child process of the test process that outlives its test:
+    a test that starts a process must end it on every path (``processes.started``)."""
+    limit = _timeout(request.config)
+    if limit > 0:
+        faulthandler.dump_traceback_later(limit + BACKSTOP, exit=True,
+                                          file=_stderr_fd(request.config))
+    before = children_now()
+    yield
+    if limit > 0:
+        faulthandler.cancel_dump_traceback_later()
+    if request.node.get_closest_marker("fixture_children"):
+        return                  # children a longer-lived fixture owns and ends itself
+    left = leftover_children(before, CHILD_GRACE)
+    if left:
+        pytest.fail("child processes outlived the test (killed now): "
+                    + "; ".join(kill_tree(left)), pytrace=False)
+
+
+@pytest.fixture
+def sigint_python():
+    """SIGINT raises KeyboardInterrupt for the test's duration, also when pytest was
+    started with SIGINT ignored (``nohup ... &``): what ``_thread.interrupt_main()``
+    and children started inside (SIGINT at its default) rely on."""
+    with sigint_handled():
+        yield
 
 
 @pytest.fixture

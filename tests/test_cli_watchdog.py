@@ -9,6 +9,8 @@ import subprocess
 import sys
 from pathlib import Path
 
+from processes import started
+
 ROOT = Path(__file__).resolve().parents[1]
 
 CHILD = """
@@ -16,8 +18,8 @@ import sys, time
 from assocopt.cli import watchdog
 watchdog.GRACE = 0.3
 watchdog.arm(130)
-print("ready", flush=True)
-try:
+try:                          # "ready" inside: the interrupt may come at once
+    print("ready", flush=True)
     time.sleep(30)
 except KeyboardInterrupt:
     pass                      # the interrupt lost, as in a finaliser
@@ -26,22 +28,20 @@ print("still running", flush=True)
 """
 
 
-def _run_child(code: str) -> subprocess.Popen:
+def _run_child(code: str):
+    """The child running ``code`` (SIGINT at its default, killed at the block's end)."""
     env = dict(os.environ, PYTHONPATH=str(ROOT))
-    return subprocess.Popen([sys.executable, "-c", code], env=env, text=True,
-                            stdout=subprocess.PIPE, stderr=subprocess.PIPE)
+    return started([sys.executable, "-c", code], env=env, text=True,
+                   stdout=subprocess.PIPE, stderr=subprocess.PIPE)
 
 
 def test_a_lost_interrupt_still_ends_the_program():
-    proc = _run_child(CHILD)
-    try:
+    with _run_child(CHILD) as proc:
         assert proc.stdout.readline().strip() == "ready"
         proc.send_signal(signal.SIGINT)
         out, err = proc.communicate(timeout=50)
         assert proc.returncode == 130, (out, err)
         assert "still running" not in out and "assocopt: interrupted" in err
-    finally:
-        proc.kill()
 
 
 def test_an_ignored_sigint_is_left_alone():
@@ -50,6 +50,6 @@ def test_an_ignored_sigint_is_left_alone():
             "from assocopt.cli import watchdog\n"
             "watchdog.arm(130)\n"
             "print(signal.getsignal(signal.SIGINT) is signal.SIG_IGN)")
-    proc = _run_child(code)
-    out, _ = proc.communicate(timeout=50)
+    with _run_child(code) as proc:
+        out, _ = proc.communicate(timeout=50)
     assert out.strip() == "True"

@@ -394,7 +394,7 @@ def test_declared_options_are_consistent(name):
 
 
 @pytest.mark.parametrize("kw, option", [
-    ({"time_limit": True}, "time_limit"), ({"time_limit": float("inf")}, "time_limit"),
+    ({"time_limit": True}, "time_limit"), ({"time_limit": -float("inf")}, "time_limit"),
     ({"time_limit": float("nan")}, "time_limit"), ({"time_limit": -1.0}, "time_limit"),
     ({"time_limit": 0}, "time_limit"), ({"time_limit": "5"}, "time_limit"),
     ({"mip_gap": 1.0}, "mip_gap"), ({"mip_gap": -0.1}, "mip_gap"),

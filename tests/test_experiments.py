@@ -15,6 +15,7 @@ import numpy as np
 import pytest
 
 from assocopt.runtime.errors import AssocoptError
+from processes import started
 from assocopt.experiments import (Experiment, PerMethod, ResultStore, StoreMismatchError,
                                   TrialError, _demo_trial, association_metrics,
                                   run_experiment, setting_key, summarise, trial_seed)
@@ -116,8 +117,7 @@ def test_killed_process_resumes_to_the_same_table(tmp_path):
     store = tmp_path / "k.sqlite"
     env = dict(os.environ, PYTHONPATH=os.pathsep.join(
         [os.path.dirname(os.path.dirname(os.path.abspath(__file__)))] + sys.path))
-    proc = subprocess.Popen([sys.executable, "-c", _KILL_SCRIPT, str(store)], env=env)
-    try:
+    with started([sys.executable, "-c", _KILL_SCRIPT, str(store)], env=env) as proc:
         deadline = time.monotonic() + 60
         while time.monotonic() < deadline and proc.poll() is None:
             time.sleep(0.05)
@@ -130,9 +130,6 @@ def test_killed_process_resumes_to_the_same_table(tmp_path):
         assert proc.poll() is None, "the run finished before it could be killed"
         proc.send_signal(signal.SIGKILL)
         proc.wait(10)
-    finally:
-        if proc.poll() is None:
-            proc.kill()
     with ResultStore(store) as st:
         kept = st.count()
     assert 6 <= kept < 160 and kept % 2 == 0              # whole trials (both methods) only

@@ -27,6 +27,7 @@ from assocopt.workflow.generate import generate_dense
 from assocopt.io import read_instance, write_instance
 from assocopt.model.solution import Status
 from assocopt.solvers import registered
+from processes import started
 
 ROOT = Path(__file__).resolve().parents[1]
 ENV = {**os.environ, "PYTHONPATH": str(ROOT) + os.pathsep + os.environ.get("PYTHONPATH", "")}
@@ -244,14 +245,9 @@ class TestReadCap:
             pytest.skip("no /dev/zero")
         fifo = tmp_path / "endless.txt"
         os.mkfifo(fifo)
-        writer = subprocess.Popen(["sh", "-c", f"yes 1 > '{fifo}'"],
-                                  stderr=subprocess.DEVNULL)
-        try:
+        with started(["sh", "-c", f"yes 1 > '{fifo}'"], stderr=subprocess.DEVNULL):
             bad_input(capsys, fifo, "--max-bytes", "100000", "validate", fifo,
                       words=("larger than the limit",))
-        finally:
-            writer.kill()
-            writer.wait()
 
 
 # ------------------------------------------------------------------ detection
@@ -337,29 +333,32 @@ class TestUserPaths:
         out_dir.mkdir()
         target = out_dir / "x.mps"
         for delay in (1.0, 2.5):
-            proc = subprocess.Popen([sys.executable, "-m", "assocopt", "export",
-                                     str(hard_file), "--to", str(target)], env=ENV,
-                                    stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
-            time.sleep(delay)
-            proc.send_signal(signal.SIGTERM)
-            _, err = proc.communicate(timeout=120)
-            assert proc.returncode in (0, 130, -signal.SIGTERM, -signal.SIGINT), err
+            with started([sys.executable, "-m", "assocopt", "export", hard_file,
+                          "--to", target], env=ENV, stdout=subprocess.PIPE,
+                         stderr=subprocess.PIPE, text=True) as proc:
+                time.sleep(delay)
+                proc.send_signal(signal.SIGTERM)
+                _, err = proc.communicate(timeout=120)
+            assert proc.returncode in (0, 130, -signal.SIGTERM, -signal.SIGINT), \
+                (proc.returncode, err)
             leftovers = [p.name for p in out_dir.iterdir() if p.name.startswith(".")]
             assert leftovers == [], leftovers
 
 
 # ------------------------------------------------------------------ interrupts
 def _interrupt(path: Path, solver: str, after: float = 2.0) -> tuple[int, str]:
-    """Start ``assocopt solve`` in a child, SIGINT it ``after`` s into the solve."""
+    """Start ``assocopt solve`` in a child, SIGINT it ``after`` s into the solve (the
+    child gets SIGINT at its default action even if pytest runs with it ignored, and
+    is killed with its process group whatever happens)."""
     code = ("import sys; from assocopt.cli import main; print('ready', flush=True); "
             f"sys.argv = ['assocopt', 'solve', {str(path)!r}, '--solver', {solver!r}]; "
             "sys.exit(main())")
-    proc = subprocess.Popen([sys.executable, "-c", code], env=ENV, text=True,
-                            stdout=subprocess.PIPE, stderr=subprocess.PIPE)
-    assert proc.stdout.readline().strip() == "ready"
-    time.sleep(after)
-    proc.send_signal(signal.SIGINT)
-    _, err = proc.communicate(timeout=300)
+    with started([sys.executable, "-c", code], env=ENV, text=True,
+                 stdout=subprocess.PIPE, stderr=subprocess.PIPE) as proc:
+        assert proc.stdout.readline().strip() == "ready"
+        time.sleep(after)
+        proc.send_signal(signal.SIGINT)
+        _, err = proc.communicate(timeout=300)
     return proc.returncode, err
 
 
@@ -416,9 +415,9 @@ class TestTimeLimits:
 
         monkeypatch.setattr(scipy.optimize, "milp", spy)
         small = AssignmentProblem.dense(np.arange(9.0).reshape(3, 3))
-        solve(small, "scipy", time_limit=5.0)
+        solve(small, "scipy", time_limit=5.0, isolate=False)    # spied in this process
         solve(small, "scipy")
-        solve(small, "scipy", time_limit=5.0, presolve=True)
+        solve(small, "scipy", time_limit=5.0, presolve=True, isolate=False)
         assert seen[0]["presolve"] is False and "presolve" not in seen[1]
         assert seen[2]["presolve"] is True
         assert solve(small, "highs", time_limit=5.0).info["presolve"] == "off"
@@ -478,11 +477,9 @@ class TestProcesses:
     """SIGKILL of ``assocopt reproduce``: its pool workers and the resource tracker exit."""
 
     def test_workers_exit_with_parent(self, tmp_path):
-        proc = subprocess.Popen([sys.executable, "-m", "assocopt", "reproduce", "zhang2009",
-                                 "--runs", "1000", "--workers", "2", "--out",
-                                 str(tmp_path / "r")], env=ENV,
-                                stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
-        try:
+        with started([sys.executable, "-m", "assocopt", "reproduce", "zhang2009",
+                      "--runs", "1000", "--workers", "2", "--out", tmp_path / "r"],
+                     env=ENV, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL) as proc:
             kids: list[int] = []
             for _ in range(600):                       # until the pool is up
                 kids = _children(proc.pid)
@@ -490,16 +487,13 @@ class TestProcesses:
                     break
                 time.sleep(0.1)
             assert len(kids) >= 3, "pool workers and resource tracker did not start"
-        finally:
             proc.kill()
             proc.wait()
-        for _ in range(300):
-            if not any(_alive(k) for k in kids):
-                break
-            time.sleep(0.1)
-        left = [k for k in kids if _alive(k)]
-        for k in left:
-            os.kill(k, signal.SIGKILL)
+            for _ in range(300):
+                if not any(_alive(k) for k in kids):
+                    break
+                time.sleep(0.1)
+            left = [k for k in kids if _alive(k)]
         assert left == [], "children outlived their killed parent"
 
 
@@ -547,6 +541,7 @@ class TestDistributed:
         a, b = _trial_numbers(local), _trial_numbers(remote)
         assert a and a == b
 
+    @pytest.mark.fixture_children
     def test_killed_worker_loses_no_trial(self, dask_cluster, tmp_path):
         from assocopt.experiments import Experiment, ResultStore, _demo_trial, run_experiment
 

@@ -1,6 +1,6 @@
 """A complete install: the stored instances ship inside the package, a non-editable
-``pip install`` works from outside the checkout, and optional test helpers name the
-package to install."""
+install of the wheel works from outside the checkout (whatever the base Python has),
+and optional test helpers name the package to install."""
 
 from __future__ import annotations
 
@@ -8,6 +8,7 @@ import json
 import os
 import shutil
 import subprocess
+import sys
 import venv
 from pathlib import Path
 
@@ -106,31 +107,61 @@ def _notebook_script(path: Path) -> str:
     return "\n\n".join("".join(c["source"]) for c in cells if c["cell_type"] == "code")
 
 
-@pytest.fixture(scope="module")
-def installed(tmp_path_factory) -> dict[str, Path]:
-    """A venv (system site-packages, so numpy & co. need no download) with assocopt
-    installed non-editable from a copy of this checkout."""
+def _site_dirs() -> list[str]:
+    """The running environment's site-packages folders, as this interpreter sees them."""
+    import site
+
+    dirs = list(site.getsitepackages())
+    if site.ENABLE_USER_SITE:
+        dirs.append(site.getusersitepackages())
+    return [d for d in dirs if d in sys.path and os.path.isdir(d)]
+
+
+def _build_wheel(src: Path, dest: Path, env: dict[str, str]) -> Path:
+    """assocopt's wheel, built by the running interpreter from ``src`` with its own
+    setuptools and wheel (the dev extra), without build isolation or downloads."""
     import importlib.util
 
     import setuptools
-    if importlib.util.find_spec("wheel") is None and \
-            tuple(int(v) for v in setuptools.__version__.split(".")[:2]) < (70, 1):
-        pytest.skip("building without isolation needs the wheel package: pip install wheel")
+    if importlib.util.find_spec("wheel") is None or \
+            tuple(int(v) for v in setuptools.__version__.split(".")[:2]) < (68, 0):
+        pytest.skip("building the wheel needs setuptools>=68 and wheel: "
+                    "pip install -e '.[dev]'")
+    done = subprocess.run([sys.executable, "-m", "pip", "wheel", "--no-deps",
+                           "--no-build-isolation", "--no-index", "--quiet",
+                           "--wheel-dir", str(dest), str(src)],
+                          env=env, capture_output=True, text=True, timeout=600)
+    if done.returncode != 0 and "No module named pip" in done.stderr:
+        pytest.skip("pip is not available to the test interpreter")
+    assert done.returncode == 0, done.stderr[-2000:]
+    (wheel,) = dest.glob("assocopt-*.whl")
+    return wheel
+
+
+@pytest.fixture(scope="module")
+def installed(tmp_path_factory) -> dict[str, Path]:
+    """A fresh venv with assocopt installed non-editable from a wheel of a copy of this
+    checkout.  The venv sees the running environment's site-packages through a
+    ``.pth`` file (numpy & co. and pip need no download), never the base
+    interpreter's, so the test passes whatever the base Python has."""
     base = tmp_path_factory.mktemp("install")
     src = _copy_source(base)
+    env = {k: v for k, v in os.environ.items() if k not in ("PYTHONPATH", "PYTHONHOME")}
+    env["PIP_DISABLE_PIP_VERSION_CHECK"] = "1"
+    wheel = _build_wheel(src, base / "dist", env)
     env_dir = base / "venv"
     try:
-        venv.EnvBuilder(system_site_packages=True, with_pip=False).create(env_dir)
+        venv.EnvBuilder(with_pip=False).create(env_dir)
     except Exception as exc:  # pragma: no cover - platform without venv
         pytest.skip(f"cannot create a venv: {exc}")
     python = env_dir / ("Scripts" if os.name == "nt" else "bin") / "python"
-    env = {k: v for k, v in os.environ.items() if k not in ("PYTHONPATH", "PYTHONHOME")}
-    env["PIP_DISABLE_PIP_VERSION_CHECK"] = "1"
-    done = subprocess.run([str(python), "-m", "pip", "install", "--no-deps",
-                           "--no-build-isolation", "--ignore-installed", "--no-index",
-                           "--quiet", str(src)], env=env, capture_output=True, text=True)
-    if done.returncode != 0 and "No module named pip" in done.stderr:
-        pytest.skip("pip is not available to the venv")
+    purelib = subprocess.run([str(python), "-c", "import sysconfig; "
+                              "print(sysconfig.get_paths()['purelib'])"], env=env,
+                             capture_output=True, text=True, check=True).stdout.strip()
+    Path(purelib, "_assocopt_test_env.pth").write_text("\n".join(_site_dirs()) + "\n")
+    done = subprocess.run([str(python), "-m", "pip", "install", "--no-deps", "--no-index",
+                           "--ignore-installed", "--quiet", str(wheel)],
+                          env=env, capture_output=True, text=True, timeout=600)
     assert done.returncode == 0, done.stderr[-2000:]
     work = base / "elsewhere"
     work.mkdir()

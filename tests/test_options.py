@@ -67,7 +67,7 @@ def test_bad_value_names_solver_option_and_value():
 def test_native_options_pass_through_and_unknown_names_do_not():
     p = AssignmentProblem.dense(np.array([[4.0, 1.0], [2.0, 3.0]]))
     sol = solve(p, "highs", presolve="off")
-    assert sol.objective == 3.0 and sol.info["options"] == {"presolve": "off"}
+    assert sol.objective == 3.0 and sol.info["options"] == {"presolve": "off", "isolate": None}
     with pytest.raises(OptionError, match="it also takes any HiGHS option by name"):
         solve(p, "highs", presolv="off")
     if get_backend("ortools-cpsat").is_available():
@@ -167,3 +167,32 @@ def test_backends_map_statuses_through_tables():
     for module in (highs, scipy_milp, ortools_cpsat, ortools_mip, cvxpy_backend):
         table = module._STATUS_TABLE
         assert table and all(isinstance(k, str) for k in table), module.__name__
+
+
+# ------------------------------------------------------------------ no limit
+@pytest.mark.parametrize("solver", sorted(n for n, c in registered().items()
+                                          if c.supports_time_limit))
+def test_infinite_time_limit_means_no_limit(solver):
+    """``time_limit=inf`` is no limit (as in HiGHS), for every back end that takes one:
+    the answer and the recorded options are those of ``time_limit=None``."""
+    if not registered()[solver].is_available():
+        pytest.skip(f"{solver} not installed")
+    p = AssignmentProblem.dense(np.random.default_rng(3).random((3, 3, 3)))
+    free = solve(p, solver)
+    sol = solve(p, solver, time_limit=math.inf)
+    assert sol.status is free.status and sol.status.value in ("optimal", "feasible")
+    assert sol.objective == pytest.approx(free.objective)
+    assert sol.info.get("options", {}).get("time_limit") is None
+    assert sol.info.get("isolated") is None          # no child process without a limit
+
+
+def test_infinite_time_limit_in_a_model_file_and_on_the_command_line(tmp_path, capsys):
+    from assocopt.workflow.models import load_model
+
+    f = tmp_path / "m.toml"
+    f.write_text('formulation = "ilp"\nsolver = "highs"\n[options]\ntime_limit = inf\n')
+    p = AssignmentProblem.dense(np.random.default_rng(3).random((3, 3, 3)))
+    assert load_model(str(f)).solve(p).status.value == "optimal"
+    inst = Path(__file__).resolve().parents[1] / "instances" / "example-3d.json"
+    assert main(["solve", str(inst), "--solver", "highs", "--time-limit", "inf"]) == 0
+    assert "optimal" in capsys.readouterr().out

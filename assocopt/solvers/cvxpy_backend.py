@@ -27,6 +27,7 @@ with another solver and ``mip_gap > 0`` a solution is FEASIBLE, never OPTIMAL.
 
 from __future__ import annotations
 
+import dataclasses
 import time
 import warnings
 from typing import Any
@@ -34,12 +35,13 @@ from typing import Any
 import numpy as np
 
 from ..runtime.errors import InvalidProblemError, SolverCapabilityError, SolverNotInstalledError
-from ..model.formulation import build_model
+from ..model.formulation import LinearModel, build_model
 from ..problems.problem import AssignmentProblem
 from ..model.solution import Status, relative_gap
 from .base import (Backend, Option, RawResult, SolveOptions, empty_answer, register,
                    remaining)
 from .interruptible import run_cancellable
+from .limited import ISOLATE, killed_at_limit, run_limited
 from .status import from_table, settle_optimal
 
 __all__ = ["CvxpyBackend"]
@@ -175,90 +177,63 @@ class CvxpyBackend(Backend):
                nullable=True),
         Option("solver_options", "dict", {}, "solver keyword options passed to CVXPY, "
                "merged over the limits assocopt sets"),
+        ISOLATE,
     )
 
     def solve(self, problem: AssignmentProblem, options: SolveOptions) -> RawResult:
-        import cvxpy as cp
-
         is_mip = options.relax is None
         extra = self.settings(problem, options)
+        isolate = extra.pop("isolate", None)
         if (empty := empty_answer(problem, options, self.name)) is not None:
             return empty
-        requested = extra["cvxpy_solver"]
-        user_opts = dict(extra["solver_options"])
-        solver = _choose_solver(requested, is_mip, cp.installed_solvers())
-        limit_opts, passed = _limit_options(solver, options, is_mip)
-        solver_opts = _merge(limit_opts, user_opts)
-        info: dict[str, Any] = {"cvxpy_solver": solver, "limits_passed": passed}
-
         t0 = time.perf_counter()
+        start = time.monotonic()
         model = build_model(problem, options.relax)
-        K = model.shape[1]
-        constraints: list[Any] = []
-        if is_mip:
-            x = cp.Variable(K, boolean=True)
-        elif solver in _NO_VARIABLE_BOUNDS:
-            x = cp.Variable(K)
-            constraints += [x >= 0, x <= 1]
-        else:                  # column bounds, not K extra rows, where the solver takes them
-            x = cp.Variable(K, bounds=[0.0, 1.0])
-        constraints.append(model.A @ x == 1)
-        prob = cp.Problem(cp.Minimize(model.c @ x), constraints)
-        t1: float | None = None
-        try:
-            with warnings.catch_warnings():
-                if not options.verbose:
-                    warnings.simplefilter("ignore")
-                data, chain, inverse = prob.get_problem_data(
-                    solver=solver, verbose=bool(options.verbose), solver_opts=solver_opts)
-                t1 = time.perf_counter()
-                # the solver gets what is left of the limit after CVXPY's compilation
-                limit_opts, passed = _limit_options(solver, remaining(options, t0), is_mip)
-                solver_opts = _merge(limit_opts, user_opts)
-                info["limits_passed"] = passed
-                # in a worker thread so that Ctrl-C takes effect at once (.interruptible)
-                raw, _ = run_cancellable(chain.solve_via_data, (prob, data), None, kwargs=dict(
-                    warm_start=False, verbose=bool(options.verbose), solver_opts=solver_opts))
-                prob.unpack_results(raw, chain, inverse)
-        except cp.error.SolverError as exc:      # includes CVXPY's "solver_error" status
-            t2 = time.perf_counter()
-            t1 = t2 if t1 is None else t1
+        t_model = time.perf_counter()
+        args = (model, extra["cvxpy_solver"], dict(extra["solver_options"]),
+                dataclasses.replace(options, extra={}, parsed=True))
+        if options.time_limit is not None and isolate is not False:
+            out = run_limited("assocopt.solvers.cvxpy_backend:run_model", args,
+                              options.time_limit, start)
+            if out is None:
+                return killed_at_limit(self.name, options.time_limit, 0.0,
+                                       time.perf_counter() - t0)
+        else:
+            out = run_model(*args, time_limit=options.time_limit and
+                            remaining(options, t0).time_limit)
+        info: dict[str, Any] = {"cvxpy_solver": out["solver"],
+                                "limits_passed": out["limits_passed"]}
+        if "startup" in out:
+            info["isolated"] = round(out["startup"], 4)
+        solver, build, solve_time = out["solver"], out["build_time"], out["solve_time"]
+        build += t_model - t0                  # assocopt's CSR model, then CVXPY's
+        if "solver_error" in out:
             # SCIPY (and others) report "no solution" as an error when the limit hits.
-            if options.time_limit is not None and t2 - t1 >= options.time_limit:
-                return RawResult(Status.TIME_LIMIT, info=info, build_time=t1 - t0,
-                                 solve_time=t2 - t1,
+            if options.time_limit is not None and solve_time >= options.time_limit:
+                return RawResult(Status.TIME_LIMIT, info=info, build_time=build,
+                                 solve_time=solve_time,
                                  message=f"cvxpy/{solver}: no solution within the time "
-                                         f"limit ({exc})")
-            return RawResult(Status.ERROR, message=f"cvxpy/{solver}: {exc}", info=info,
-                             build_time=t1 - t0, solve_time=t2 - t1)
-        except (ValueError, TypeError) as exc:
-            if user_opts:                         # most likely a rejected solver option
-                raise InvalidProblemError(
-                    f"cvxpy/{solver} rejected solver_options {user_opts!r}: {exc}") from exc
-            raise
-        t2 = time.perf_counter()
-
-        native = str(prob.status)
+                                         f"limit ({out['solver_error']})")
+            return RawResult(Status.ERROR, message=f"cvxpy/{solver}: {out['solver_error']}",
+                             info=info, build_time=build, solve_time=solve_time)
+        native = out["status"]
         info["cvxpy_status"] = native
-        result = RawResult(Status.ERROR, info=info, build_time=t1 - t0, solve_time=t2 - t1)
-        values = x.value
-        objective = bound = None
+        result = RawResult(Status.ERROR, info=info, build_time=build, solve_time=solve_time)
+        values, objective, bound = out["x"], None, None
         if values is not None and native in ("optimal", "optimal_inaccurate", "user_limit"):
-            values = np.asarray(values, dtype=np.float64).ravel()
-            objective = float(prob.value)
+            objective = out["objective"]
             if is_mip:
                 selected = np.flatnonzero(values > 0.5)
                 # A limit-stopped solver may hand back a non-incumbent point: keep
                 # only a selection that is a feasible assignment.
                 if native == "optimal" or problem.violations(selected) is None:
                     result.selected = selected
-                bound = self._bound(prob)
-                result.bound = bound
+                bound = result.bound = out["bound"]
             else:
                 result.x = values
                 result.objective = objective
         result.status, note = self._status(native, solver, objective, bound, options,
-                                           is_mip, t2 - t1)
+                                           is_mip, solve_time)
         result.message = f"cvxpy/{solver}: {native}" + (f"; {note}" if note else "")
         return result
 
@@ -290,3 +265,65 @@ class CvxpyBackend(Backend):
             return Status.ERROR, f"unexpected CVXPY status {native!r}"
         return settle_optimal(status, relative_gap(objective, bound),
                               options.mip_gap if is_mip else 0.0)
+
+
+def run_model(model: LinearModel, requested: str | None, user_opts: dict[str, Any],
+              options: SolveOptions, *, time_limit: float | None = None) -> dict[str, Any]:
+    """CVXPY's model of ``model`` compiled and solved in this process (the solver call in
+    a worker thread, so that Ctrl-C takes effect at once, see :mod:`.interruptible`);
+    what the result needs as plain values (the same in a child process, :mod:`.limited`).
+    ``time_limit`` counts from the call; the solver gets what compilation left of it."""
+    import cvxpy as cp
+
+    t0 = time.perf_counter()
+    if time_limit is not None:
+        options = dataclasses.replace(options, time_limit=time_limit)
+    is_mip = options.relax is None
+    solver = _choose_solver(requested, is_mip, cp.installed_solvers())
+    limit_opts, passed = _limit_options(solver, options, is_mip)
+    solver_opts = _merge(limit_opts, user_opts)
+    out: dict[str, Any] = {"solver": solver, "limits_passed": passed,
+                           "build_time": 0.0, "solve_time": 0.0}
+    K = model.shape[1]
+    constraints: list[Any] = []
+    if is_mip:
+        x = cp.Variable(K, boolean=True)
+    elif solver in _NO_VARIABLE_BOUNDS:
+        x = cp.Variable(K)
+        constraints += [x >= 0, x <= 1]
+    else:                  # column bounds, not K extra rows, where the solver takes them
+        x = cp.Variable(K, bounds=[0.0, 1.0])
+    constraints.append(model.A @ x == 1)
+    prob = cp.Problem(cp.Minimize(model.c @ x), constraints)
+    t1: float | None = None
+    try:
+        with warnings.catch_warnings():
+            if not options.verbose:
+                warnings.simplefilter("ignore")
+            data, chain, inverse = prob.get_problem_data(
+                solver=solver, verbose=bool(options.verbose), solver_opts=solver_opts)
+            t1 = time.perf_counter()
+            # the solver gets what is left of the limit after CVXPY's compilation
+            limit_opts, out["limits_passed"] = _limit_options(
+                solver, remaining(options, t0), is_mip)
+            solver_opts = _merge(limit_opts, user_opts)
+            raw, _ = run_cancellable(chain.solve_via_data, (prob, data), None, kwargs=dict(
+                warm_start=False, verbose=bool(options.verbose), solver_opts=solver_opts))
+            prob.unpack_results(raw, chain, inverse)
+    except cp.error.SolverError as exc:      # includes CVXPY's "solver_error" status
+        t2 = time.perf_counter()
+        t1 = t2 if t1 is None else t1
+        out.update(solver_error=str(exc), build_time=t1 - t0, solve_time=t2 - t1)
+        return out
+    except (ValueError, TypeError) as exc:
+        if user_opts:                         # most likely a rejected solver option
+            raise InvalidProblemError(
+                f"cvxpy/{solver} rejected solver_options {user_opts!r}: {exc}") from exc
+        raise
+    t2 = time.perf_counter()
+    values = x.value
+    out.update(build_time=t1 - t0, solve_time=t2 - t1, status=str(prob.status),
+               x=None if values is None else np.asarray(values, np.float64).ravel(),
+               objective=None if prob.value is None or values is None else float(prob.value),
+               bound=CvxpyBackend._bound(prob) if is_mip else None)
+    return out

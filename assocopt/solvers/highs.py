@@ -18,6 +18,7 @@ from ..model.formulation import LinearModel, build_model
 from ..problems.problem import AssignmentProblem
 from ..model.solution import Status
 from .base import Backend, RawResult, SolveOptions, empty_answer, register, remaining
+from .limited import ISOLATE, killed_at_limit, run_limited
 from .status import from_table, settle_optimal
 
 __all__ = ["HighsBackend", "highs_from_model"]
@@ -102,6 +103,31 @@ def run_highs(h: Any, deadline: float | None = None) -> None:
         h.HandleUserInterrupt = False
 
 
+def run_model(model: LinearModel, options: SolveOptions, *,
+              time_limit: float | None = None) -> dict[str, Any]:
+    """Solve ``model`` with HiGHS in this process; what the result needs, as plain
+    values (the same in a child process, :mod:`.limited`).  ``time_limit`` replaces
+    the options' limit (what is left of it in the child)."""
+    import dataclasses
+
+    if time_limit is not None:
+        options = dataclasses.replace(options, time_limit=time_limit)
+    h = highs_from_model(model, options)
+    t1 = time.perf_counter()
+    run_highs(h, None if options.time_limit is None else t1 + options.time_limit + 0.1)
+    t2 = time.perf_counter()
+    info = h.getInfo()
+    has_primal = info.primal_solution_status == 2  # kSolutionStatusFeasible
+    return {"status": h.getModelStatus().name, "solve_time": t2 - t1,
+            "message": h.modelStatusToString(h.getModelStatus()),
+            "x": np.asarray(h.getSolution().col_value, dtype=np.float64) if has_primal
+            else None,
+            "dual_bound": float(info.mip_dual_bound), "mip_gap": float(info.mip_gap),
+            "objective": float(info.objective_function_value),
+            "presolve": _option(h, "presolve"),
+            "nodes": int(getattr(info, "mip_node_count", 0))}
+
+
 @register
 class HighsBackend(Backend):
     """HiGHS MIP (branch and cut) or LP (dual simplex / IPM) via highspy."""
@@ -113,51 +139,54 @@ class HighsBackend(Backend):
     lp = True
     supports_time_limit = True
     native_options = "any HiGHS option by name (presolve=\"off\", mip_heuristic_effort=0.1, ...)"
+    options = (ISOLATE,)
 
     @classmethod
     def is_native_option(cls, name: str) -> bool:
         return cls.is_available() and name in _highs_option_names()
 
     def solve(self, problem: AssignmentProblem, options: SolveOptions) -> RawResult:
-        import highspy
-
         extra = self.settings(problem, options)
+        isolate = extra.pop("isolate", None)
         if (empty := empty_answer(problem, options, self.name)) is not None:
             return empty
         t0 = time.perf_counter()
+        start = time.monotonic()
         model = build_model(problem, options.relax)
-        left = remaining(options, t0).time_limit      # building counts against the limit
-        h = highs_from_model(model, SolveOptions(
-            relax=options.relax, time_limit=left, mip_gap=options.mip_gap,
-            threads=options.threads, verbose=options.verbose, extra=extra, parsed=True))
+        sub = SolveOptions(relax=options.relax, time_limit=options.time_limit,
+                           mip_gap=options.mip_gap, threads=options.threads,
+                           verbose=options.verbose, extra=extra, parsed=True)
         t1 = time.perf_counter()
-        run_highs(h, None if options.time_limit is None
-                  else t0 + options.time_limit + 0.1)
-        t2 = time.perf_counter()
-        status_name = h.getModelStatus().name
-        info = h.getInfo()
-        has_primal = info.primal_solution_status == 2  # kSolutionStatusFeasible
-        x = np.asarray(h.getSolution().col_value, dtype=np.float64) if has_primal else None
+        if options.time_limit is not None and isolate is not False:
+            out = run_limited("assocopt.solvers.highs:run_model", (model, sub),
+                              options.time_limit, start)
+            if out is None:
+                return killed_at_limit(self.name, options.time_limit, t1 - t0,
+                                       time.perf_counter() - t1)
+        else:
+            out = run_model(model, sub, time_limit=remaining(options, t0).time_limit)
+        return self._result(out, model, options, t1 - t0)
+
+    def _result(self, out: dict[str, Any], model: LinearModel, options: SolveOptions,
+                build_time: float) -> RawResult:
         bound: float | None = None
-        if model.is_mip and np.isfinite(info.mip_dual_bound):
-            bound = float(info.mip_dual_bound)
-        result = RawResult(status=self._status(status_name, model, info, options),
-                           message=f"HiGHS: {h.modelStatusToString(h.getModelStatus())}",
-                           build_time=t1 - t0, solve_time=t2 - t1, bound=bound,
-                           info={"highs_status": status_name,
-                                 "presolve": _option(h, "presolve"),
-                                 "mip_node_count": int(getattr(info, "mip_node_count", 0))})
+        if model.is_mip and np.isfinite(out["dual_bound"]):
+            bound = out["dual_bound"]
+        gap = out["mip_gap"] if model.is_mip else 0.0
+        status = settle_optimal(from_table(_STATUS_TABLE, out["status"]), gap,
+                                options.mip_gap if model.is_mip else 0.0)[0]
+        info = {"highs_status": out["status"], "presolve": out["presolve"],
+                "mip_node_count": out["nodes"]}
+        if "startup" in out:
+            info["isolated"] = round(out["startup"], 4)
+        result = RawResult(status=status, message=f"HiGHS: {out['message']}",
+                           build_time=build_time, solve_time=out["solve_time"],
+                           bound=bound, info=info)
+        x = out["x"]
         if x is not None:
             if model.is_mip:
                 result.selected = np.flatnonzero(x > 0.5)
             else:
                 result.x = x
-                result.objective = float(info.objective_function_value)
-        del highspy
+                result.objective = out["objective"]
         return result
-
-    @staticmethod
-    def _status(name: str, model: LinearModel, info: Any, options: SolveOptions) -> Status:
-        status = from_table(_STATUS_TABLE, name)
-        gap = float(info.mip_gap) if model.is_mip else 0.0
-        return settle_optimal(status, gap, options.mip_gap if model.is_mip else 0.0)[0]

@@ -186,8 +186,8 @@ class Option:
 
 #: The options every back end takes (arguments of :func:`assocopt.solve`).
 COMMON_OPTIONS: tuple[Option, ...] = (
-    Option("time_limit", "float", None, "seconds; a run stopped by it reports time_limit",
-           low=0.0, low_open=True, high=math.inf, high_open=True, nullable=True),
+    Option("time_limit", "float", None, "seconds (inf or None: no limit); a run stopped "
+           "by it reports time_limit", low=0.0, low_open=True, nullable=True),
     Option("mip_gap", "float", 0.0, "relative gap at which a MIP solver may stop "
            "(0: prove optimality)", low=0.0, high=1.0, high_open=True),
     Option("threads", "int", None, "worker threads (None: the back end's default)",
@@ -213,6 +213,8 @@ def check_common(time_limit: Any = None, mip_gap: Any = 0.0, threads: Any = None
             out.append(_COMMON[name].check(value))
         except ValueError as exc:
             raise OptionError(f"{name} {exc}", name, str(exc)) from None
+    if out[0] == math.inf:                  # no limit, as in HiGHS
+        out[0] = None
     return out[0], out[1], out[2], out[3]
 
 

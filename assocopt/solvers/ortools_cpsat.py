@@ -182,8 +182,10 @@ class CpSatBackend(Backend):
         solver = cp_model.CpSolver()
         _apply_parameters(solver.parameters, remaining(options, t0), extra)
         t1 = time.perf_counter()
-        # in a worker thread: Ctrl-C calls stop_search and CP-SAT returns at once
-        native, _ = run_cancellable(solver.solve, (cp,), solver.stop_search)
+        # in a worker thread: Ctrl-C calls stop_search and CP-SAT returns at once; so
+        # does the deadline (CP-SAT's own clock is not looked at in every phase)
+        native, _ = run_cancellable(solver.solve, (cp,), solver.stop_search, deadline=None
+                                    if options.time_limit is None else t0 + options.time_limit)
         t2 = time.perf_counter()
 
         response = solver.response_proto

@@ -37,6 +37,7 @@ from ..model.formulation import build_model
 from ..problems.problem import AssignmentProblem
 from ..model.solution import Status, relative_gap
 from .base import Backend, Option, RawResult, SolveOptions, register, remaining
+from .interruptible import run_cancellable
 from .status import from_table, settle_optimal
 
 __all__ = ["OrtoolsMipBackend"]
@@ -187,13 +188,17 @@ class OrtoolsMipBackend(Backend):
             solver.set_solver_specific_parameters(text)
         t1 = time.perf_counter()
         with _silenced(not options.verbose):
-            solver.solve(helper)
+            # at the deadline the solve is interrupted from outside too: the solver's
+            # own clock is not looked at in every phase (SCIP's presolve)
+            _, by_clock = run_cancellable(solver.solve, (helper,), solver.interrupt_solve,
+                                          deadline=None if options.time_limit is None
+                                          else t0 + options.time_limit)
         t2 = time.perf_counter()
 
         native = solver.status().name
         detail = solver.status_string() if solver.has_response() else ""
-        if "SCIP status code 10" in detail:   # SCIP_STATUS_USERINTERRUPT: SCIP caught Ctrl-C
-            raise KeyboardInterrupt
+        if "SCIP status code 10" in detail and not by_clock:
+            raise KeyboardInterrupt           # SCIP_STATUS_USERINTERRUPT: SCIP caught Ctrl-C
         if native == "INVALID_SOLVER_PARAMETERS" and user_text:
             raise InvalidProblemError(
                 f"ortools-mip backend {backend!r} rejected the parameters {user_text!r}: "

@@ -8,15 +8,17 @@ beyond ``time_limit``, ``mip_rel_gap``, ``presolve``, ``node_limit`` and ``disp`
 from __future__ import annotations
 
 import time
+from typing import Any
 
 import numpy as np
 
-from ..model.formulation import build_model
+from ..model.formulation import LinearModel, build_model
 from ..problems.problem import AssignmentProblem
 from ..model.solution import Status
 from .base import (Backend, Option, RawResult, SolveOptions, empty_answer, register,
                    remaining)
 from .interruptible import run_cancellable
+from .limited import ISOLATE, killed_at_limit, run_limited
 from .status import from_table, settle_optimal
 
 __all__ = ["ScipyMilpBackend"]
@@ -47,44 +49,67 @@ class ScipyMilpBackend(Backend):
                nullable=True),
         Option("node_limit", "int", None, "largest number of branch-and-bound nodes",
                low=1, nullable=True),
+        ISOLATE,
     )
 
     def solve(self, problem: AssignmentProblem, options: SolveOptions) -> RawResult:
-        from scipy.optimize import Bounds, LinearConstraint, milp
-
         extra = {k: v for k, v in self.settings(problem, options).items() if v is not None}
+        isolate = extra.pop("isolate", None)
         if (empty := empty_answer(problem, options, self.name)) is not None:
             return empty
         t0 = time.perf_counter()
+        start = time.monotonic()
         model = build_model(problem, options.relax)
-        constraint = LinearConstraint(model.A, model.row_lower, model.row_upper)
         opts: dict[str, object] = {"disp": bool(options.verbose),
                                    "mip_rel_gap": float(options.mip_gap)}
         if options.time_limit is not None:
             # HiGHS presolve ignores the clock (see assocopt.solvers.highs): off with a limit
-            opts["time_limit"] = float(remaining(options, t0).time_limit)
             opts["presolve"] = False
         opts.update(extra)
         t1 = time.perf_counter()
-        # in a worker thread: scipy has no interrupt hook, but Ctrl-C then takes effect
-        # at once (the abandoned solve ends on its own, see .interruptible)
-        res, _ = run_cancellable(milp, (model.c,), None, kwargs=dict(
-            integrality=model.integrality, bounds=Bounds(model.lb, model.ub),
-            constraints=constraint, options=opts))
+        if options.time_limit is not None and isolate is not False:
+            res = run_limited("assocopt.solvers.scipy_milp:run_model", (model, opts),
+                              options.time_limit, start)
+            if res is None:
+                return killed_at_limit(self.name, options.time_limit, t1 - t0,
+                                       time.perf_counter() - t1)
+        else:
+            res = run_model(model, opts, time_limit=remaining(options, t0).time_limit)
         t2 = time.perf_counter()
-        gap = getattr(res, "mip_gap", None)
-        status, _ = settle_optimal(from_table(_STATUS_TABLE, str(int(res.status))),
-                                   None if gap is None else float(gap),
-                                   options.mip_gap if model.is_mip else 0.0)
-        bound = getattr(res, "mip_dual_bound", None)
-        out = RawResult(status=status, message=f"scipy.milp: {res.message}",
+        status, _ = settle_optimal(from_table(_STATUS_TABLE, str(res["status"])),
+                                   res["mip_gap"], options.mip_gap if model.is_mip else 0.0)
+        bound = res["mip_dual_bound"]
+        out = RawResult(status=status, message=f"scipy.milp: {res['message']}",
                         build_time=t1 - t0, solve_time=t2 - t1,
                         bound=float(bound) if bound is not None and np.isfinite(bound) else None,
-                        info={"scipy_status": int(res.status)})
-        if res.x is not None:
+                        info={"scipy_status": res["status"]})
+        if "startup" in res:
+            out.info["isolated"] = round(res["startup"], 4)
+        if res["x"] is not None:
             if model.is_mip:
-                out.selected = np.flatnonzero(res.x > 0.5)
+                out.selected = np.flatnonzero(res["x"] > 0.5)
             else:
-                out.x = np.asarray(res.x, dtype=np.float64)
-                out.objective = float(res.fun)
+                out.x = np.asarray(res["x"], dtype=np.float64)
+                out.objective = float(res["fun"])
         return out
+
+
+def run_model(model: LinearModel, opts: dict[str, object], *,
+              time_limit: float | None = None) -> dict[str, Any]:
+    """``scipy.optimize.milp`` on ``model`` in this process (in a worker thread, so that
+    Ctrl-C takes effect at once; the abandoned solve ends on its own, see
+    :mod:`.interruptible`), its result as plain values (the same in a child process,
+    :mod:`.limited`)."""
+    from scipy.optimize import Bounds, LinearConstraint, milp
+
+    if time_limit is not None:
+        opts = dict(opts, time_limit=float(time_limit))
+    constraint = LinearConstraint(model.A, model.row_lower, model.row_upper)
+    res, _ = run_cancellable(milp, (model.c,), None, kwargs=dict(
+        integrality=model.integrality, bounds=Bounds(model.lb, model.ub),
+        constraints=constraint, options=opts))
+    gap = getattr(res, "mip_gap", None)
+    return {"status": int(res.status), "message": str(res.message), "x": res.x,
+            "fun": None if res.x is None else float(res.fun),
+            "mip_gap": None if gap is None else float(gap),
+            "mip_dual_bound": getattr(res, "mip_dual_bound", None)}

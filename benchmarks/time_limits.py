@@ -1,0 +1,188 @@
+"""Do time limits hold?  Every back end that advertises a limit, on Grundel n = 50,
+with every core kept busy by spinning processes.
+
+    python benchmarks/time_limits.py                  # writes docs/benchmarks-limits.{md,json}
+    python benchmarks/time_limits.py --limits 1 --no-write
+
+For each back end and limit: the wall time of ``solve(problem, name, time_limit=L)``
+(building the model included; each back end's package imported beforehand, as in a
+program that already uses it), its overshoot past ``L`` and whether it is within the
+tolerance max(1 s, 10 % of L).  HiGHS and scipy's milp run in a child process under a
+limit (``isolate``, :mod:`assocopt.solvers.limited`); they are also run in this
+process (``isolate=False``) for comparison.  The start-up cost of the child (seconds
+from spawn until it has imported the solver and read the model) is measured on a
+3x3x3 problem without the spinning processes (best and median of ``--rounds``), and recorded
+for every isolated run above.  The instance is ``ap3.50.1`` from ``../shared/
+ap_instances`` (the public Grundel set), or, without it, the tests' hard50 (dense
+3-D n = 50, costs 1000..2000, seed 5).
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import os
+import platform
+import statistics
+import subprocess
+import sys
+import time
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+ROOT = Path(__file__).resolve().parents[1]
+sys.path.insert(0, str(ROOT))
+
+from assocopt import AssignmentProblem, solve  # noqa: E402
+from assocopt.solvers import registered  # noqa: E402
+
+PAGE = ROOT / "docs" / "benchmarks-limits.md"
+DATA = ROOT / "docs" / "benchmarks-limits.json"
+GRUNDEL = ROOT.parent / "shared" / "ap_instances" / "grundel_ap3" / "ap3.50.1.txt"
+ISOLATING = ("highs", "scipy", "cvxpy")
+
+
+def tolerance(limit: float) -> float:
+    """How far past its limit a run may end: max(1 s, 10 %)."""
+    return max(1.0, 0.1 * limit)
+
+
+def instance(path: Path = GRUNDEL) -> tuple[str, AssignmentProblem]:
+    if path.is_file():
+        from assocopt.io import read_instance
+        return f"Grundel {path.stem}", read_instance(path)
+    from assocopt.workflow.generate import generate_dense
+    return "hard50 (dense 3-D n = 50, seed 5)", generate_dense(
+        np.random.default_rng(5), (50, 50, 50), low=1000, high=2000)
+
+
+def busy(n: int) -> list[subprocess.Popen]:
+    """``n`` processes spinning on a core each (ended by :func:`stop`, or when this
+    process dies: they spin while their parent is this one)."""
+    code = f"import os\nwhile os.getppid() == {os.getpid()}: pass"
+    return [subprocess.Popen([sys.executable, "-c", code]) for _ in range(n)]
+
+
+def stop(procs: list[subprocess.Popen]) -> None:
+    for p in procs:
+        p.kill()
+        p.wait()
+
+
+def run_one(problem: AssignmentProblem, name: str, limit: float,
+            isolate: bool | None) -> dict[str, Any]:
+    kw = {} if isolate is None else {"isolate": isolate}
+    t = time.perf_counter()
+    sol = solve(problem, name, time_limit=limit, **kw)
+    wall = time.perf_counter() - t
+    return {"solver": name, "limit": limit, "isolate": isolate,
+            "wall": round(wall, 3), "overshoot": round(wall - limit, 3),
+            "within": wall <= limit + tolerance(limit), "status": sol.status.value,
+            "objective": sol.objective, "startup": sol.info.get("isolated")}
+
+
+def startup(rounds: int) -> dict[str, dict[str, float]]:
+    """Seconds until an isolated child is ready, idle cores, tiny problem."""
+    p = AssignmentProblem.dense(np.random.default_rng(0).random((3, 3, 3)))
+    out = {}
+    for name in ISOLATING:
+        if not registered()[name].is_available():
+            continue
+        got = [solve(p, name, time_limit=600.0).info["isolated"] for _ in range(rounds)]
+        out[name] = {"best": min(got), "median": statistics.median(got)}
+    return out
+
+
+def measure(limits: list[float], n_busy: int, rounds: int,
+            path: Path = GRUNDEL) -> dict[str, Any]:
+    label, problem = instance(path)
+    names = sorted(n for n, c in registered().items()
+                   if c.supports_time_limit and c.is_available())
+    tiny = AssignmentProblem.dense(np.ones((3, 3, 3)))
+    for name in names:              # imports (and bnb's compilation) outside the timing
+        solve(tiny, name)
+    load_startup = round(os.getloadavg()[0], 2)
+    idle = startup(rounds)
+    runs = []
+    spinners = busy(n_busy)
+    try:
+        time.sleep(1.0)
+        load = os.getloadavg()
+        for limit in limits:
+            for name in names:
+                runs.append(run_one(problem, name, limit, None))
+                print(runs[-1], flush=True)
+                if name in ISOLATING:
+                    runs.append(run_one(problem, name, limit, False))
+                    print(runs[-1], flush=True)
+        load_end = os.getloadavg()
+    finally:
+        stop(spinners)
+    return {"instance": label, "limits": limits, "busy": n_busy, "cpus": os.cpu_count(),
+            "load_start": [round(x, 2) for x in load], "load_end":
+            [round(x, 2) for x in load_end], "python": platform.python_version(),
+            "startup_idle": idle, "load_startup": load_startup, "runs": runs,
+            "command": "python benchmarks/time_limits.py"}
+
+
+def startup_sentence(js: dict[str, Any]) -> str:
+    """The child's start-up in words, as the README and the guide quote it."""
+    parts = [f"{s['median']:.1f} s for `{name}`" for name, s in js["startup_idle"].items()]
+    return "about " + ", ".join(parts) + f" (median of the rounds on {js['cpus']} cores at " \
+        f"load average {js.get('load_startup', '?')}: an upper bound; " \
+        "`benchmarks/time_limits.py`)"
+
+
+def render(js: dict[str, Any]) -> str:
+    """The generated part of docs/benchmarks-limits.md."""
+    lines = [f"Instance: {js['instance']}; {js['busy']} spinning processes on "
+             f"{js['cpus']} cores; load average {js['load_start'][0]} at the start, "
+             f"{js['load_end'][0]} at the end (Python {js['python']}).", "",
+             "| back end | limit (s) | where | wall (s) | overshoot (s) | within max(1 s, 10 %) "
+             "| status | child ready after (s) |", "|---|---|---|---|---|---|---|---|"]
+    for r in js["runs"]:
+        where = ("this process" if r["isolate"] is False else
+                 "child process" if r["solver"] in ISOLATING else "this process")
+        ready = r["startup"] if r["startup"] is not None else ""
+        lines.append(f"| `{r['solver']}` | {r['limit']:g} | {where} | {r['wall']:.2f} | "
+                     f"{r['overshoot']:+.2f} | {'yes' if r['within'] else '**no**'} | "
+                     f"{r['status']} | {ready} |")
+    lines += ["", "Start-up of the child process (3x3x3 problem, no spinning processes, "
+              f"load average {js.get('load_startup', '?')}; best / median of the rounds):",
+              ""]
+    for name, s in js["startup_idle"].items():
+        lines.append(f"* `{name}`: {s['best']:.2f} s / {s['median']:.2f} s")
+    return "\n".join(lines)
+
+
+def write_page(js: dict[str, Any]) -> None:
+    text = PAGE.read_text()
+    head, rest = text.split("<!-- limits:begin -->")
+    _, tail = rest.split("<!-- limits:end -->")
+    PAGE.write_text(f"{head}<!-- limits:begin -->\n{render(js)}\n<!-- limits:end -->{tail}")
+
+
+def main(argv: list[str] | None = None) -> int:
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--limits", default="1,5", help="time limits, seconds (comma list)")
+    ap.add_argument("--busy", type=int, default=os.cpu_count() or 2,
+                    help="spinning processes (default: one per core)")
+    ap.add_argument("--rounds", type=int, default=5, help="start-up measurements")
+    ap.add_argument("--instance", type=Path, default=GRUNDEL,
+                    help="Grundel file (default: ../shared/ap_instances/grundel_ap3/"
+                         "ap3.50.1.txt beside the checkout)")
+    ap.add_argument("--no-write", action="store_true")
+    args = ap.parse_args(argv)
+    js = measure([float(x) for x in args.limits.split(",")], args.busy, args.rounds,
+                 args.instance)
+    print(render(js))
+    if not args.no_write:
+        DATA.write_text(json.dumps(js, indent=1) + "\n")
+        write_page(js)
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

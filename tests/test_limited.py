@@ -1,0 +1,143 @@
+"""Time limits that hold: under a limit, HiGHS, scipy's milp and cvxpy solve in a child
+process (``assocopt.solvers.limited``) that is killed at the deadline or on Ctrl-C.
+
+No wall-clock assertions: a killed child is recognised by ``info["isolated"]`` and the
+autouse fixture of conftest.py checks that no child process outlives its test.
+"""
+
+from __future__ import annotations
+
+import _thread
+import threading
+
+import numpy as np
+import pytest
+
+from assocopt import AssignmentProblem, solve
+from assocopt.runtime.errors import InvalidProblemError
+from assocopt.workflow.generate import generate_dense
+from assocopt.model.solution import Status
+from assocopt.solvers import limited, registered
+
+ISOLATED = [n for n in ("highs", "scipy", "cvxpy") if registered()[n].is_available()]
+
+
+@pytest.fixture(scope="module")
+def hard():
+    """Dense 3-D n = 30: far more than half a second for HiGHS under a limit."""
+    return generate_dense(np.random.default_rng(5), (30, 30, 30), low=1000, high=2000)
+
+
+@pytest.mark.parametrize("relax", [None, "lp"])
+@pytest.mark.parametrize("solver", ISOLATED)
+def test_the_child_gives_the_same_answer(solver, relax):
+    p = AssignmentProblem.dense(np.random.default_rng(1).random((4, 4, 4)))
+    inside = solve(p, solver, relax=relax, time_limit=60.0, isolate=False)
+    child = solve(p, solver, relax=relax, time_limit=60.0)
+    assert "isolated" not in inside.info and isinstance(child.info["isolated"], float)
+    assert child.status is inside.status is Status.OPTIMAL
+    assert child.objective == pytest.approx(inside.objective)
+    if relax is None:
+        assert sorted(map(tuple, child.tuples)) == sorted(map(tuple, inside.tuples))
+    else:
+        np.testing.assert_allclose(child.x, inside.x, atol=1e-9)
+
+
+@pytest.mark.parametrize("solver", ISOLATED)
+def test_no_child_without_a_limit(solver):
+    p = AssignmentProblem.dense(np.random.default_rng(1).random((3, 3)))
+    assert "isolated" not in solve(p, solver).info
+
+
+@pytest.mark.parametrize("solver", ISOLATED)
+def test_a_child_still_running_at_the_deadline_is_killed(solver, hard, monkeypatch):
+    """The kill deadline moved to half a second after the start, far before the
+    solver's own limit: the child is killed and the run reports time_limit."""
+    monkeypatch.setattr(limited, "kill_slack", lambda limit: 0.5 - limit)
+    sol = solve(hard, solver, time_limit=60.0)
+    assert sol.info["isolated"] == "killed"
+    assert sol.status is Status.TIME_LIMIT and not sol.has_solution
+    assert "time limit" in sol.message
+
+
+@pytest.mark.parametrize("solver", ISOLATED)
+def test_ctrl_c_kills_the_child(solver, hard, sigint_python):
+    timer = threading.Timer(0.5, _thread.interrupt_main)
+    timer.start()
+    try:
+        with pytest.raises(KeyboardInterrupt):
+            solve(hard, solver, time_limit=600.0)
+    finally:
+        timer.cancel()
+
+
+def test_an_error_in_the_child_is_raised_here():
+    p = AssignmentProblem.dense(np.random.default_rng(1).random((3, 3)))
+    if "highs" not in ISOLATED:
+        pytest.skip("highspy not installed")
+    with pytest.raises(InvalidProblemError, match="mip_heuristic_effort"):
+        solve(p, "highs", time_limit=60.0, mip_heuristic_effort="lots")
+
+
+def test_kill_slack_fits_the_tolerance():
+    for limit in (0.1, 1.0, 10.0, 100.0):
+        assert 0 < limit.__class__(limited.kill_slack(limit)) < max(1.0, 0.1 * limit)
+
+
+def test_limits_page_and_docs_agree_with_the_committed_run():
+    """docs/benchmarks-limits.md is what benchmarks/time_limits.py renders from its
+    committed JSON, and the README and the guide quote its start-up figures."""
+    import json
+    from pathlib import Path
+
+    from conftest import load_script, page_block
+
+    root = Path(__file__).resolve().parents[1]
+    bench = load_script("benchmarks/time_limits.py", "bench_time_limits")
+    js = json.loads((root / "docs" / "benchmarks-limits.json").read_text())
+    page = (root / "docs" / "benchmarks-limits.md").read_text()
+    assert page_block(page, "limits") == bench.render(js).strip()
+    sentence = bench.startup_sentence(js)
+    for doc in ("README.md", "docs/guide.md"):
+        text = " ".join((root / doc).read_text().split())
+        assert sentence in text, doc
+    assert {r["solver"] for r in js["runs"]} >= set(ISOLATED)
+
+
+def test_the_child_exits_when_its_parent_is_killed(hard, tmp_path):
+    """SIGKILL of a process solving under a limit: its solver child notices (it watches
+    its parent, assocopt.runtime.parent_watch) and exits."""
+    import os
+    import subprocess
+    import sys
+    import time
+    from pathlib import Path
+
+    import psutil
+
+    from assocopt.io import write_instance
+    from processes import started
+
+    if "highs" not in ISOLATED:
+        pytest.skip("highspy not installed")
+    path = tmp_path / "hard.json"
+    write_instance(hard, path)
+    root = Path(__file__).resolve().parents[1]
+    code = ("import sys; from assocopt import solve; from assocopt.io import read_instance; "
+            "p = read_instance(sys.argv[1]); print('ready', flush=True); "
+            "solve(p, 'highs', time_limit=600.0)")
+    env = dict(os.environ, PYTHONPATH=str(root))
+    with started([sys.executable, "-c", code, path], env=env, text=True,
+                 stdout=subprocess.PIPE) as proc:
+        assert proc.stdout.readline().strip() == "ready"
+        kids: list[psutil.Process] = []
+        for _ in range(1200):                 # until the solver's child is up
+            kids = psutil.Process(proc.pid).children()
+            if kids or proc.poll() is not None:
+                break
+            time.sleep(0.05)
+        assert kids, "no solver child process started"
+        proc.kill()
+        proc.wait()
+        _, alive = psutil.wait_procs(kids, timeout=60)
+        assert alive == [], "the solver's child outlived its killed parent"
