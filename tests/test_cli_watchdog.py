@@ -53,3 +53,18 @@ def test_an_ignored_sigint_is_left_alone():
     with _run_child(code) as proc:
         out, _ = proc.communicate(timeout=50)
     assert out.strip() == "True"
+
+
+def test_an_error_caused_by_ctrl_c_is_an_interruption_not_a_bug():
+    """A native module whose import is interrupted raises ImportError with the
+    KeyboardInterrupt in its chain: the program reports exit 130, not an internal
+    error; an unrelated error stays an internal error."""
+    from assocopt.cli.app import _caused_by_interrupt
+    try:
+        try:
+            raise KeyboardInterrupt
+        except KeyboardInterrupt:
+            raise ImportError("initialization failed")
+    except ImportError as exc:
+        assert _caused_by_interrupt(exc)
+    assert not _caused_by_interrupt(ValueError("a real bug"))

@@ -14,7 +14,7 @@ from ..runtime.errors import AssocoptError
 from .common import (EXIT_BAD_INPUT, EXIT_BROKEN_PIPE, EXIT_INTERNAL, EXIT_INTERRUPTED,
                      _error, _one_line, _os_message, _UsageError)
 from .parser import _build_parser
-from .watchdog import arm
+from .watchdog import arm, interrupted
 from .solve_cmds import _cmd_compare, _cmd_solve, _cmd_solvers, _cmd_validate
 from .workflow_cmds import (_cmd_convert, _cmd_export, _cmd_generate, _cmd_instances,
                             _cmd_models, _cmd_reproduce)
@@ -78,6 +78,26 @@ def _exit_now_if_solver_threads(as_program: bool) -> None:
     os._exit(EXIT_INTERRUPTED)
 
 
+def _interrupted(err: TextIO, as_program: bool) -> int:
+    print("assocopt: interrupted", file=err)
+    _exit_now_if_solver_threads(as_program)
+    return EXIT_INTERRUPTED
+
+
+def _caused_by_interrupt(exc: BaseException) -> bool:
+    """An error raised because of a Ctrl-C: one with a ``KeyboardInterrupt`` in its
+    chain, or any error after the program's handler saw a Ctrl-C (a native extension
+    interrupted while importing reports ``ImportError: initialization failed``)."""
+    seen: set[int] = set()
+    e: BaseException | None = exc
+    while e is not None and id(e) not in seen:
+        if isinstance(e, KeyboardInterrupt):
+            return True
+        seen.add(id(e))
+        e = e.__cause__ or e.__context__
+    return interrupted()
+
+
 def main(argv: Sequence[str] | None = None) -> int:
     """Run the command line; returns the exit code (see :mod:`assocopt.cli`)."""
     out, err = sys.stdout, sys.stderr
@@ -106,10 +126,10 @@ def main(argv: Sequence[str] | None = None) -> int:
         _error(err, _os_message(exc))
         return EXIT_BAD_INPUT
     except KeyboardInterrupt:
-        print("assocopt: interrupted", file=err)
-        _exit_now_if_solver_threads(argv is None)
-        return EXIT_INTERRUPTED
+        return _interrupted(err, argv is None)
     except Exception as exc:  # noqa: BLE001 - the CLI never shows a traceback
+        if _caused_by_interrupt(exc):
+            return _interrupted(err, argv is None)
         _error(err, f"internal error ({type(exc).__name__}: {_one_line(str(exc))}); "
                     "this is a bug in assocopt or a back end, please report it")
         return EXIT_INTERNAL

@@ -18,10 +18,20 @@ import sys
 import threading
 from typing import Any, Callable
 
-__all__ = ["arm", "GRACE"]
+__all__ = ["arm", "interrupted", "GRACE"]
 
 #: Seconds between the first Ctrl-C and the forced exit.
 GRACE = 5.0
+
+#: Set by the armed handler on the first Ctrl-C: an exception that follows it (an
+#: extension module whose import was interrupted raises ``ImportError`` instead of
+#: ``KeyboardInterrupt``) is then reported as an interruption, not as a bug.
+_FIRED = threading.Event()
+
+
+def interrupted() -> bool:
+    """Whether the armed handler has seen a Ctrl-C in this process."""
+    return _FIRED.is_set()
 
 
 def arm(exit_code: int) -> Callable[[], None]:
@@ -30,7 +40,8 @@ def arm(exit_code: int) -> Callable[[], None]:
     if threading.current_thread() is not threading.main_thread() or \
             signal.getsignal(signal.SIGINT) is not signal.default_int_handler:
         return lambda: None       # a thread, or SIGINT ignored / taken over by the caller
-    fired = threading.Event()
+    fired = _FIRED
+    fired.clear()
 
     def leave_later() -> None:
         threading.Event().wait(GRACE)
