@@ -160,9 +160,12 @@ def test_nscan_prune_keeps_agreement_on_the_oldest_scan():
 def test_tag_arrays_pad_truncate_and_pairs():
     hist, lab = tag_arrays([[], [3], [1, 2, 3, 4]], 3)
     assert hist.tolist() == [[0, 0, 0], [0, 0, 3], [2, 3, 4]]
-    assert lab[1, :, 1].tolist() == [-1, -1, 0]
-    hist, lab = tag_arrays([[(2, 1), (0, 0)]], 2)
-    assert hist.tolist() == [[2, 0]] and lab[0].tolist() == [[2, 1], [0, 0]]
+    assert (lab[:, :, 0] == hist).all() and (lab[:, :, 1] == 0).all()
+    hist, lab = tag_arrays([[(2, 1), (0, 0)], [(3, 0)]], 2)
+    assert hist.tolist() == [[2, 0], [0, 3]]
+    assert lab.tolist() == [[[2, 1], [0, 0]], [[0, -1], [3, 0]]]
+    with pytest.raises(ValueError, match="all hold detection indices"):
+        tag_arrays([[(2, 1)], [3]], 2)
     with pytest.raises(ValueError, match="window must be a positive integer"):
         tag_arrays([[1]], 0)
 

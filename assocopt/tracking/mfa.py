@@ -274,24 +274,29 @@ def tag_arrays(tags: Sequence[Sequence], window: int) -> tuple[np.ndarray, np.nd
     history : (H, window) int64
         Detection index per scan (the problem's slots).
     labels : (H, window, 2) int64
-        (detection index, hypothesiser index) per scan, -1 as the padding's
-        hypothesiser index and 0 for plain tags: what :func:`nscan_prune` compares.
+        (detection index, hypothesiser index) per scan (-1 as the padding's
+        hypothesiser index; 0 throughout for plain tags): what :func:`nscan_prune`
+        compares.
     """
     if isinstance(window, bool) or int(window) != window or window < 1:
         raise ValueError(f"window must be a positive integer, got {window!r}")
-    labels = np.zeros((len(tags), window, 2), np.int64)
-    labels[:, :, 1] = -1
-    for h, tag in enumerate(tags):
-        part = list(tag)[-window:]
-        if part:
-            arr = np.asarray(part, np.int64).reshape(len(part), -1)
-            if arr.shape[1] > 2:
-                raise ValueError(f"tag entry of hypothesis {h} has {arr.shape[1]} values; "
-                                 "expected a detection index or (detection, hypothesiser)")
-            labels[h, window - len(part):, :arr.shape[1]] = arr
-            if arr.shape[1] == 1:
-                labels[h, window - len(part):, 1] = 0
-    return labels[:, :, 0].copy(), labels
+    window = int(window)
+    first = next((tag[-1] for tag in tags if len(tag)), 0)
+    pairs = isinstance(first, (tuple, list, np.ndarray))
+    pad = [(0, -1)] if pairs else [0]
+    try:
+        arr = np.array([pad * (window - len(tag)) + list(tag[-window:]) for tag in tags],
+                       dtype=np.int64)
+    except (TypeError, ValueError) as exc:
+        raise ValueError("tags must all hold detection indices, or all (detection, "
+                         f"hypothesiser) pairs: {exc}") from None
+    if pairs:
+        if arr.ndim != 3 or arr.shape[2] != 2:
+            raise ValueError(f"tag entries must be (detection, hypothesiser) pairs, got "
+                             f"an array of shape {arr.shape}")
+        return arr[:, :, 0].copy(), arr
+    arr = arr.reshape(len(tags), window)
+    return arr, np.stack([arr, np.zeros_like(arr)], axis=2)
 
 
 def log_cost(weight: Any) -> float:

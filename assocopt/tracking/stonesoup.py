@@ -268,8 +268,9 @@ class AssocoptMFA(DataAssociator):
         order = [t for t, hyps in hypotheses.items() if len(hyps)]
         flat = [h for t in order for h in hypotheses[t]]
         track_id = np.repeat(np.arange(len(order)), [len(hypotheses[t]) for t in order])
-        cost = np.array([log_cost(h.prediction.weight) for h in flat], np.float64)
-        history, labels = tag_arrays([h.prediction.tag for h in flat], self.slide_window)
+        preds = [h.prediction for h in flat]
+        cost = np.array([log_cost(p.weight) for p in preds], np.float64)
+        history, labels = tag_arrays([p.tag for p in preds], self.slide_window)
         wp = window_problem(track_id, cost, history, n_tracks=len(order))
         opts = self.solver_options or {}
         if self.k == 1:
