@@ -247,3 +247,12 @@ def test_k_best_keeps_the_union_of_the_ranked_histories():
     assert sum(len(v) for v in four.values()) > sum(len(v) for v in one.values())
     with pytest.raises(ValueError, match="positive integer"):
         AssocoptMFA(hyp, slide_window=2, k=0).associate_hypotheses(hypotheses)
+
+
+def test_guide_mfa_figure_script_runs_the_guide_section(tmp_path):
+    from conftest import load_script
+    mod = load_script("docs/mfa_figure.py", "mfa_figure")
+    blocks = mod.section_blocks(section=mod.SECTION)
+    assert len(blocks) == 1 and "AssocoptMFA(" in blocks[0]
+    out = mod.main(["--out", str(tmp_path / "fig.png")])
+    assert out.stat().st_size > 10_000

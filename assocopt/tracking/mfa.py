@@ -231,7 +231,7 @@ def ranked_window(wp: WindowProblem, k: int, solver: str = "auto", **options: An
                 choice[t] = a[i]
             found.append((float(sol.objective) + total, rank, pick, choice))
     found.sort(key=lambda f: (f[0], f[1], f[2]))
-    return [f[0] for f in found[:k]], [f[3] for f in found[:k]], ranked
+    return [float(f[0]) for f in found[:k]], [f[3] for f in found[:k]], ranked
 
 
 def nscan_prune(track, labels, best: Sequence[np.ndarray], n_old: int = 1) -> np.ndarray:
