@@ -118,16 +118,18 @@ def test_problem_from_hypotheses_has_the_miss_candidates():
         assert (j == 0) == (not h)
 
 
-def test_missing_stonesoup_names_the_extra():
+@pytest.mark.parametrize("module", ["stonesoup", "stonesoup_hypothesiser"])
+def test_missing_stonesoup_names_the_extra(module):
     code = ("import sys; sys.modules['stonesoup'] = None\n"
-            "try:\n    import assocopt.tracking.stonesoup\n"
+            f"try:\n    import assocopt.tracking.{module}\n"
             "except ImportError as exc:\n    print(exc)")
     assert "pip install assocopt[stonesoup]" in fresh_python(code)
 
 
 def test_importing_tracking_does_not_import_stonesoup():
     code = ("import sys, assocopt.tracking, assocopt.tracking.gating, "
-            "assocopt.tracking.costs.kinematic, assocopt.tracking.sd_gating; "
+            "assocopt.tracking.costs.kinematic, assocopt.tracking.sd_gating, "
+            "assocopt.tracking.mfa, assocopt.tracking.simulate; "
             "print('stonesoup' in sys.modules)")
     assert fresh_python(code).strip() == "False"
 
