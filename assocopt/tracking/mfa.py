@@ -180,7 +180,7 @@ def chosen_hypotheses(wp: WindowProblem, solution: Solution) -> np.ndarray:
 
 
 def solve_window(wp: WindowProblem, solver: str = "auto", **options: Any
-                 ) -> tuple[Solution, np.ndarray]:
+                 ) -> tuple[Solution, np.ndarray | None]:
     """The optimal global hypothesis: the core's :func:`~assocopt.solve` and its choice."""
     sol = solve(wp.problem, solver, **options)
     return sol, (chosen_hypotheses(wp, sol) if sol.has_solution else None)

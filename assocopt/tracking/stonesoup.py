@@ -267,7 +267,8 @@ class AssocoptMFA(DataAssociator):
             raise ValueError(f"k must be a positive integer, got {self.k!r}")
         order = [t for t, hyps in hypotheses.items() if len(hyps)]
         flat = [h for t in order for h in hypotheses[t]]
-        track_id = np.repeat(np.arange(len(order)), [len(hypotheses[t]) for t in order])
+        track_id = np.repeat(np.arange(len(order)),
+                             [len(hypotheses[t]) for t in order]).astype(np.int64)
         preds = [h.prediction for h in flat]
         cost = np.array([log_cost(p.weight) for p in preds], np.float64)
         history, labels = tag_arrays([p.tag for p in preds], self.slide_window)
@@ -286,7 +287,7 @@ class AssocoptMFA(DataAssociator):
                                f"{sol.message}".strip())
         keep = nscan_prune(track_id, labels, best)
         out = {t: MultipleHypothesis([]) for t in hypotheses}
-        for i, t in enumerate(order):
-            out[t] = MultipleHypothesis([flat[j] for j in np.flatnonzero(
-                keep & (track_id == i))])
+        counts = np.bincount(track_id, minlength=len(order))
+        for t, hi, n in zip(order, np.cumsum(counts).tolist(), counts.tolist()):
+            out[t] = MultipleHypothesis([flat[j] for j in range(hi - n, hi) if keep[j]])
         return out
