@@ -176,3 +176,18 @@ def test_chosen_hypotheses_of_an_infeasible_window_is_an_error():
     assert choice is None and sol.status.value == "infeasible"
     with pytest.raises(ValueError, match="no solution"):
         chosen_hypotheses(wp, sol)
+
+
+@settings(max_examples=40)
+@given(hypothesis_sets(), st.sampled_from(["highs", "scipy", "bnb", "lagrangian-exact",
+                                           "ortools-cpsat"]))
+def test_every_exact_back_end_solves_the_window_problem(data, solver):
+    track, cost, history = data
+    wp = window_problem(track, cost, history)
+    every = every_global_hypothesis(track, cost, history)
+    sol, choice = solve_window(wp, solver)
+    if not every:
+        assert not sol.has_solution
+        return
+    assert sol.objective == pytest.approx(every[0][0], abs=1e-6)
+    assert float(cost[choice].sum()) == pytest.approx(sol.objective, abs=1e-6)
