@@ -21,11 +21,12 @@ ROOT = Path(__file__).resolve().parents[1]
 SECTION = "## From measurements to a decision"
 
 
-def section_blocks(guide: Path = ROOT / "docs" / "guide.md") -> list[str]:
-    """The python blocks of the guide's tracking section, in order."""
+def section_blocks(guide: Path = ROOT / "docs" / "guide.md",
+                   section: str = SECTION) -> list[str]:
+    """The python blocks of one section of the guide (the tracking one), in order."""
     text = guide.read_text(encoding="utf-8")
-    start = text.index(SECTION)
-    end = text.find("\n## ", start + len(SECTION))
+    start = text.index(section)
+    end = text.find("\n## ", start + len(section))
     body = text[start:end if end > 0 else None]
     return re.findall(r"^```python\n(.*?)^```", body, re.MULTILINE | re.DOTALL)
 

@@ -118,16 +118,18 @@ def test_problem_from_hypotheses_has_the_miss_candidates():
         assert (j == 0) == (not h)
 
 
-def test_missing_stonesoup_names_the_extra():
+@pytest.mark.parametrize("module", ["stonesoup", "stonesoup_hypothesiser"])
+def test_missing_stonesoup_names_the_extra(module):
     code = ("import sys; sys.modules['stonesoup'] = None\n"
-            "try:\n    import assocopt.tracking.stonesoup\n"
+            f"try:\n    import assocopt.tracking.{module}\n"
             "except ImportError as exc:\n    print(exc)")
     assert "pip install assocopt[stonesoup]" in fresh_python(code)
 
 
 def test_importing_tracking_does_not_import_stonesoup():
     code = ("import sys, assocopt.tracking, assocopt.tracking.gating, "
-            "assocopt.tracking.costs.kinematic, assocopt.tracking.sd_gating; "
+            "assocopt.tracking.costs.kinematic, assocopt.tracking.sd_gating, "
+            "assocopt.tracking.mfa, assocopt.tracking.simulate; "
             "print('stonesoup' in sys.modules)")
     assert fresh_python(code).strip() == "False"
 
@@ -142,7 +144,8 @@ def test_k_best_joint_hypotheses_equal_stone_soups_enumeration(k):
     tracks = {Track([p]) for p in priors}
     t, dets = scans[0]
     hypotheses = {tr: hyp.hypothesise(tr, dets, t) for tr in tracks}
-    ranked = AssocoptKBest(hyp, k=k).associate_hypotheses(hypotheses)
+    ranker = AssocoptKBest(hyp, k=k)
+    ranked = ranker.rank_hypotheses(hypotheses)
     every = sorted(float(j.distance) for j in
                    GlobalNearestNeighbour.enumerate_joint_hypotheses(hypotheses))
     assert 8 < len(every) < 50                       # the scene has real alternatives
@@ -151,8 +154,44 @@ def test_k_best_joint_hypotheses_equal_stone_soups_enumeration(k):
     assert len(set(keys)) == len(keys)                    # distinct joint hypotheses
     best = AssocoptGNN(hyp).associate_hypotheses(hypotheses)
     assert keys[0] == frozenset((tr, h.measurement) for tr, h in best.items())
+    assert ranker.last_ranked.objectives == pytest.approx(every[:k])
+    assert [float(j.distance) for j in ranker.rank(tracks, dets, t)] == pytest.approx(every[:k])
     with pytest.raises(ValueError, match="positive integer"):
-        AssocoptKBest(hyp, k=0).associate_hypotheses(hypotheses)
+        AssocoptKBest(hyp, k=0).rank_hypotheses(hypotheses)
+
+
+def test_every_data_associator_returns_a_mapping_and_the_ranker_is_not_one():
+    """A DataAssociator's associate returns track -> hypothesis (what trackers use);
+    the k-best ranking, which returns a list, has its own interface."""
+    from stonesoup.dataassociator.base import DataAssociator
+    from stonesoup.tracker.simple import MultiTargetTracker
+    from assocopt.tracking import stonesoup as mod
+
+    assert not issubclass(AssocoptKBest, DataAssociator)
+    assert not hasattr(AssocoptKBest, "associate")
+    sc = CVScenario(n_targets=3, n_steps=4, clutter_rate=2.0)
+    out, scans, priors, predictor, updater = _scene(sc, seed=4)
+    hyp = DistanceHypothesiser(predictor, updater, measure=Mahalanobis(), missed_distance=3)
+    assert {c for c in vars(mod).values() if isinstance(c, type) and issubclass(
+        c, DataAssociator) and c is not DataAssociator} == {AssocoptGNN, mod.AssocoptMFA}
+
+    class Feed:                                   # a detector yielding the scans
+        def __iter__(self):
+            return iter(scans)
+
+    class Never:                                  # no initiation, no deletion
+        def initiate(self, *a, **k):
+            return set()
+
+        def delete_tracks(self, tracks):
+            return set()
+
+    tracker = MultiTargetTracker(initiator=Never(), deleter=Never(), detector=Feed(),
+                                 data_associator=AssocoptGNN(hyp), updater=updater)
+    tracker._tracks = {Track([p]) for p in priors}
+    steps = [len(tracks) for _, tracks in tracker]
+    assert steps == [3] * sc.n_steps
+    assert all(len(tr) == sc.n_steps + 1 for tr in tracker.tracks)
 
 
 def test_guide_figure_script_draws_both_loops(tmp_path):

@@ -11,8 +11,11 @@
 * :mod:`.costs.kinematic` -- Mahalanobis and log-likelihood-ratio costs of gated pairs;
 * :mod:`.sd_gating` -- S-D candidate tuples gated pairwise across sensors;
 * :mod:`.azimuth` -- azimuth-only sensors in the plane;
-* :mod:`.simulate` -- a seeded constant-velocity scenario with clutter;
-* :mod:`.stonesoup` -- assocopt as a Stone Soup data associator (optional extra).
+* :mod:`.simulate` -- seeded constant-velocity and crossing scenarios with clutter;
+* :mod:`.mfa` -- multi-frame assignment: a sliding window of scans as one S-D problem;
+* :mod:`.stonesoup` -- assocopt as Stone Soup data associators, GNN, k-best and MFA
+  (optional extra);
+* :mod:`.stonesoup_hypothesiser` -- Stone Soup's MFA hypotheses, batched (optional extra).
 
 Nothing is imported here, so ``import assocopt.tracking.costs`` loads only what it needs
 (and importing this package never imports Stone Soup).

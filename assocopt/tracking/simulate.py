@@ -15,7 +15,7 @@ import numpy as np
 
 from ..runtime.errors import InvalidProblemError
 
-__all__ = ["CVScenario", "Scans"]
+__all__ = ["CVScenario", "CrossingScenario", "Scans"]
 
 
 @dataclass(frozen=True)
@@ -129,3 +129,40 @@ class CVScenario:
             meas.append(z[order])
             labels.append(lab[order])
         return Scans(np.stack(truth), meas, labels)
+
+
+@dataclass(frozen=True)
+class CrossingScenario(CVScenario):
+    """Targets that cross in pairs: the two of pair ``j`` meet at one point, at a time
+    drawn in the middle half of the run, with headings ``crossing_angle`` apart
+    (radians); a last unpaired target flies alone.  Meeting points are spread over the
+    middle 60 % of ``region``.
+
+    Examples
+    --------
+    >>> sc = CrossingScenario(n_targets=4, n_steps=10, clutter_rate=0.0, q=0.0)
+    >>> x = sc.initial_states(np.random.default_rng(0))
+    >>> t = sc.crossing_times(np.random.default_rng(0))
+    >>> bool(np.allclose(x[0, [0, 2]] + t[0] * x[0, [1, 3]], x[1, [0, 2]] + t[0] * x[1, [1, 3]]))
+    True
+    """
+
+    crossing_angle: float = np.pi / 4
+
+    def crossing_times(self, rng: np.random.Generator) -> np.ndarray:
+        """Meeting time of each pair (the first draws of ``rng``)."""
+        T = self.n_steps * self.dt
+        return rng.uniform(0.25 * T, 0.75 * T, self.n_targets // 2)
+
+    def initial_states(self, rng: np.random.Generator) -> np.ndarray:
+        t_meet = self.crossing_times(rng)
+        (x0, x1), (y0, y1) = self.region
+        n = self.n_targets
+        meet = np.stack([rng.uniform(x0, x1, (n + 1) // 2) * 0.6,
+                         rng.uniform(y0, y1, (n + 1) // 2) * 0.6], axis=1)
+        heading = rng.uniform(-np.pi, np.pi, (n + 1) // 2)
+        heading = np.stack([heading, heading + self.crossing_angle], axis=1).ravel()[:n]
+        vel = self.speed * np.stack([np.cos(heading), np.sin(heading)], axis=1)
+        t = np.repeat(np.concatenate([t_meet, [0.0] * (n % 2)]), 2)[:n]
+        pos = np.repeat(meet, 2, axis=0)[:n] - vel * t[:, None]
+        return np.stack([pos[:, 0], vel[:, 0], pos[:, 1], vel[:, 1]], axis=1)

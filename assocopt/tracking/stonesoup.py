@@ -5,8 +5,11 @@ replacement for Stone Soup's :class:`~stonesoup.dataassociator.neighbour.GNNWith
 it takes the same hypothesiser, turns its hypotheses into a sparse 2-D
 :class:`~assocopt.problems.problem.AssignmentProblem` and returns a
 :class:`~stonesoup.types.hypothesis.JointHypothesis` (a mapping track -> hypothesis)
-from the optimum.  :class:`AssocoptKBest` returns the ``k`` best joint hypotheses
-(Murty's ranking, :func:`assocopt.kbest`).
+from the optimum.  :class:`AssocoptKBest` is not a data associator: its ``rank`` returns
+the ``k`` best joint hypotheses (Murty's ranking, :func:`assocopt.kbest`).
+:class:`AssocoptMFA` replaces :class:`~stonesoup.dataassociator.mfa.MFADataAssociator`:
+the sliding window of scans solved exactly as one S-D problem
+(:mod:`assocopt.tracking.mfa`), optionally keeping the ``k`` best global hypotheses.
 
 The problem (rows = tracks, columns = detections):
 
@@ -29,11 +32,12 @@ import math
 import numpy as np
 
 try:
-    from stonesoup.base import Property
+    from stonesoup.base import Base, Property
     from stonesoup.dataassociator.base import DataAssociator
     from stonesoup.hypothesiser import Hypothesiser
     from stonesoup.types.hypothesis import (JointHypothesis, SingleDistanceHypothesis,
                                             SingleProbabilityHypothesis)
+    from stonesoup.types.multihypothesis import MultipleHypothesis
 except ImportError as exc:  # pragma: no cover - exercised in a subprocess-free test
     raise ImportError("assocopt.tracking.stonesoup needs Stone Soup: "
                       "pip install assocopt[stonesoup]") from exc
@@ -42,7 +46,7 @@ from ..solving.api import solve
 from ..problems.problem import AssignmentProblem
 from ..model.solution import Status
 
-__all__ = ["AssocoptGNN", "AssocoptKBest", "hypotheses_problem"]
+__all__ = ["AssocoptGNN", "AssocoptKBest", "AssocoptMFA", "hypotheses_problem"]
 
 #: Accepted values of ``probability_score``.
 PROBABILITY_SCORES = ("linear", "log")
@@ -157,34 +161,133 @@ class AssocoptGNN(DataAssociator):
         return _joint(sol.tuples, tracks, table)
 
 
-class AssocoptKBest(AssocoptGNN):
-    """The ``k`` best joint hypotheses, by Murty's ranking (:func:`assocopt.kbest`).
+class AssocoptKBest(Base):
+    """Ranked joint hypotheses: the ``k`` best, by Murty's ranking (:func:`assocopt.kbest`).
 
-    ``associate`` returns a list of up to ``k`` :class:`~.JointHypothesis`, best
-    first (all of them when fewer feasible associations exist), for
-    multiple-hypothesis trackers and k-best approximations of JPDA.  The first is
-    the one :class:`AssocoptGNN` returns.
+    Not a :class:`~.DataAssociator` (whose ``associate`` returns one mapping track ->
+    hypothesis): :meth:`rank` returns a list of up to ``k`` :class:`~.JointHypothesis`,
+    best first (all of them when fewer feasible associations exist), for
+    multiple-hypothesis trackers and k-best approximations of JPDA.  The first is the
+    one :class:`AssocoptGNN` returns with the same settings; ``last_ranked`` keeps the
+    core's :class:`~assocopt.Ranked` (costs, ``exhausted``) of the latest call.
     """
 
+    hypothesiser: Hypothesiser = Property(
+        doc="Generate a set of hypotheses for each prediction-detection pair")
     k: int = Property(default=5, doc="Number of joint hypotheses to return")
+    solver: str = Property(default="auto", doc="assocopt back end of the subproblems")
+    solver_options: dict = Property(
+        default=None, doc="Keyword options passed to :func:`assocopt.kbest`")
+    probability_score: str = Property(
+        default="linear", doc="As for :class:`AssocoptGNN`: ``linear`` or ``log``")
 
-    def associate(self, tracks, detections, timestamp, **kwargs):
-        """The ``k`` best joint hypotheses, best first.
+    def __init__(self, *args, **kwargs):
+        super().__init__(*args, **kwargs)
+        self.last_ranked = None
+
+    def rank(self, tracks, detections, timestamp, **kwargs) -> list:
+        """The ``k`` best joint hypotheses of ``tracks`` and ``detections``, best first.
 
         Returns
         -------
         : list of :class:`~.JointHypothesis`
         """
-        hypotheses = self.generate_hypotheses(tracks, detections, timestamp, **kwargs)
-        return self.associate_hypotheses(hypotheses)
+        hypotheses = {track: self.hypothesiser.hypothesise(track, detections, timestamp,
+                                                           **kwargs) for track in tracks}
+        return self.rank_hypotheses(hypotheses)
 
-    def associate_hypotheses(self, hypotheses) -> list:
+    def rank_hypotheses(self, hypotheses) -> list:
         """The ``k`` best joint hypotheses of already generated ``hypotheses``."""
         from ..ranking.kbest import kbest
 
         if isinstance(self.k, bool) or int(self.k) != self.k or self.k < 1:
             raise ValueError(f"k must be a positive integer, got {self.k!r}")
         problem, tracks, table = hypotheses_problem(hypotheses, self.probability_score)
-        ranked = kbest(problem, int(self.k), solver=self.solver,
-                       **(self.solver_options or {}))
-        return [_joint(s.tuples, tracks, table) for s in ranked]
+        self.last_ranked = kbest(problem, int(self.k), solver=self.solver,
+                                 **(self.solver_options or {}))
+        return [_joint(s.tuples, tracks, table) for s in self.last_ranked]
+
+
+class AssocoptMFA(DataAssociator):
+    """Multi-frame assignment over a sliding window, solved exactly by an assocopt back end.
+
+    A drop-in replacement for Stone Soup's
+    :class:`~stonesoup.dataassociator.mfa.MFADataAssociator` (same ``hypothesiser`` and
+    ``slide_window``): the hypotheses of an ``MFAHypothesiser`` or
+    ``MHMFAHypothesiser`` (histories in ``prediction.tag``, cost ``-log(weight)``)
+    become one S-D problem (:mod:`assocopt.tracking.mfa`: one axis for the tracks, one
+    per scan of the window), solved to a proven optimum, and each track gets back
+    the :class:`~.MultipleHypothesis` of its hypotheses that survive n-scan pruning.
+    A detection is one resource per scan whatever ``MHMFAHypothesiser``'s
+    hypothesiser index (its hypothesisers model the same detections), as in Stone
+    Soup's constraints; pruning compares the whole tag entry, as Stone Soup does.
+
+    With ``k > 1`` the pruning keeps the union of the ``k`` best global hypotheses'
+    histories (an M-best multi-frame assignment).  After each call ``last_solution``
+    is the window's :class:`~assocopt.Solution` (objective = the chosen hypotheses'
+    summed ``-log(weight)``, bound, gap, status, times), ``last_costs`` the costs of
+    the global hypotheses kept (best first) and ``last_window`` the
+    :class:`~assocopt.tracking.mfa.WindowProblem`.
+    """
+
+    hypothesiser: Hypothesiser = Property(
+        doc="An MFAHypothesiser or MHMFAHypothesiser (tags hold the histories)")
+    slide_window: int = Property(doc="Length of the sliding window, in scans")
+    solver: str = Property(default="auto", doc="assocopt back end of the window problem")
+    solver_options: dict = Property(
+        default=None, doc="Keyword options passed to :func:`assocopt.solve` / ``kbest``")
+    k: int = Property(default=1, doc="Global hypotheses whose histories pruning keeps")
+
+    def __init__(self, *args, **kwargs):
+        super().__init__(*args, **kwargs)
+        self.last_solution = self.last_window = None
+        self.last_costs: list = []
+
+    def associate(self, tracks, detections, timestamp, **kwargs):
+        """Associate ``detections`` with ``tracks`` over the window.
+
+        Returns
+        -------
+        : dict of :class:`~.Track` to :class:`~.MultipleHypothesis`
+            The pruned hypotheses of each track (empty for a track without any)
+        """
+        self.last_solution, self.last_window, self.last_costs = None, None, []
+        if not tracks:
+            return {}
+        hypotheses = self.generate_hypotheses(tracks, detections, timestamp,
+                                              detections_tuple=tuple(detections), **kwargs)
+        return self.associate_hypotheses(hypotheses)
+
+    def associate_hypotheses(self, hypotheses) -> dict:
+        """The pruned hypotheses of already generated ``hypotheses`` (track -> list)."""
+        from .mfa import log_cost, nscan_prune, ranked_window, solve_window, tag_arrays
+        from .mfa import window_problem
+
+        if isinstance(self.k, bool) or int(self.k) != self.k or self.k < 1:
+            raise ValueError(f"k must be a positive integer, got {self.k!r}")
+        order = [t for t, hyps in hypotheses.items() if len(hyps)]
+        flat = [h for t in order for h in hypotheses[t]]
+        track_id = np.repeat(np.arange(len(order)),
+                             [len(hypotheses[t]) for t in order]).astype(np.int64)
+        preds = [h.prediction for h in flat]
+        cost = np.array([log_cost(p.weight) for p in preds], np.float64)
+        history, labels = tag_arrays([p.tag for p in preds], self.slide_window)
+        wp = window_problem(track_id, cost, history, n_tracks=len(order))
+        opts = self.solver_options or {}
+        if self.k == 1:
+            sol, choice = solve_window(wp, self.solver, **opts)
+            best = [choice] if sol.has_solution else []
+            costs = [sol.objective] if sol.has_solution else []
+        else:
+            costs, best, ranked = ranked_window(wp, int(self.k), self.solver, **opts)
+            sol = ranked[0] if len(ranked) else solve(wp.problem, self.solver, **opts)
+        self.last_solution, self.last_window, self.last_costs = sol, wp, costs
+        if not sol.has_solution:
+            raise RuntimeError(f"no global hypothesis of the window: {sol.status.value} "
+                               f"{sol.message}".strip())
+        keep = nscan_prune(track_id, labels, best)
+        out = {t: MultipleHypothesis([]) for t in hypotheses}
+        counts = np.bincount(track_id, minlength=len(order))
+        for t, hi, n in zip(order, np.cumsum(counts).tolist(), counts.tolist()):
+            out[t] = MultipleHypothesis([flat[j] for j in range(hi - n, hi) if keep[j]])
+        return out
