@@ -68,3 +68,29 @@ def test_an_error_caused_by_ctrl_c_is_an_interruption_not_a_bug():
     except ImportError as exc:
         assert _caused_by_interrupt(exc)
     assert not _caused_by_interrupt(ValueError("a real bug"))
+
+
+LOST = """
+import os, signal, time
+from assocopt.cli import watchdog
+watchdog.GRACE = 0.3
+watchdog.arm(130)
+class Finaliser:
+    def __del__(self):
+        os.kill(os.getpid(), signal.SIGINT)
+        time.sleep(0.5)           # the KeyboardInterrupt is raised here, and lost
+Finaliser()
+time.sleep(30)                    # the watchdog ends the process first
+print("still running", flush=True)
+"""
+
+
+def test_a_lost_interrupt_prints_no_traceback():
+    """A Ctrl-C raised inside a callback that cannot propagate it (here a finaliser;
+    in practice numba's LLVM cache notifier while compiling) is not shown as an
+    'Exception ignored' traceback: the program says 'assocopt: interrupted' and
+    exits with 130."""
+    with _run_child(LOST) as proc:
+        out, err = proc.communicate(timeout=50)
+    assert proc.returncode == 130, (out, err)
+    assert err.strip() == "assocopt: interrupted", err

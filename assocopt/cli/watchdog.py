@@ -63,5 +63,19 @@ def arm(exit_code: int) -> Callable[[], None]:
                              daemon=True).start()
         raise KeyboardInterrupt
 
+    old_hook = sys.unraisablehook
+
+    def quiet_lost_interrupt(unraisable: Any) -> None:
+        """A Ctrl-C raised inside a callback (numba's LLVM cache notifier, a
+        finaliser) is lost there: the watchdog ends the program, and the user sees
+        'assocopt: interrupted' instead of an 'Exception ignored' traceback."""
+        if not (fired.is_set() and isinstance(unraisable.exc_value, KeyboardInterrupt)):
+            old_hook(unraisable)
+
+    def disarm() -> None:
+        signal.signal(signal.SIGINT, old)
+        sys.unraisablehook = old_hook
+
     old = signal.signal(signal.SIGINT, on_sigint)
-    return lambda: signal.signal(signal.SIGINT, old)
+    sys.unraisablehook = quiet_lost_interrupt
+    return disarm
