@@ -7,7 +7,7 @@ with every core kept busy by spinning processes.
 For each back end and limit: the wall time of ``solve(problem, name, time_limit=L)``
 (building the model included; each back end's package imported beforehand, as in a
 program that already uses it), its overshoot past ``L`` and whether it is within the
-tolerance max(1 s, 10 % of L).  HiGHS and scipy's milp run in a child process under a
+tolerance max(1 s, 10 % of L).  HiGHS, scipy, cvxpy and OR-tools run in a child process under a
 limit (``isolate``, :mod:`assocopt.solvers.limited`); they are also run in this
 process (``isolate=False``) for comparison.  The start-up cost of the child (seconds
 from spawn until it has imported the solver and read the model) is measured on a
@@ -41,7 +41,7 @@ from assocopt.solvers import registered  # noqa: E402
 PAGE = ROOT / "docs" / "benchmarks-limits.md"
 DATA = ROOT / "docs" / "benchmarks-limits.json"
 GRUNDEL = ROOT.parent / "shared" / "ap_instances" / "grundel_ap3" / "ap3.50.1.txt"
-ISOLATING = ("highs", "scipy", "cvxpy")
+ISOLATING = ("highs", "scipy", "cvxpy", "ortools-cpsat", "ortools-mip")
 
 
 def tolerance(limit: float) -> float:

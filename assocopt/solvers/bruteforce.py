@@ -56,7 +56,9 @@ def enumerate_solutions(problem: AssignmentProblem, *, max_nodes: int = DEFAULT_
     """Yield the candidate positions of every feasible solution, each exactly once.
 
     ``deadline`` (a ``time.perf_counter()`` value) stops the search with
-    :class:`TimeoutError` when passed; the clock is read every 1024 nodes.
+    :class:`TimeoutError` when passed; the clock is read once the candidates' bit masks
+    are built (0.6 s for Grundel n = 50 under load) and every 256 nodes (a node can
+    scan thousands of candidates of its row: 1024 nodes overshot a 1 s limit by 0.6 s).
 
     Raises
     ------
@@ -73,6 +75,8 @@ def enumerate_solutions(problem: AssignmentProblem, *, max_nodes: int = DEFAULT_
     from ..runtime.errors import ProblemTooLargeError
 
     masks, by_row = _candidate_masks(problem)
+    if deadline is not None and time.perf_counter() > deadline:
+        raise TimeoutError("brute force stopped by the time limit before its search")
     full = (1 << problem.n_rows) - 1
     nodes = 0
     chosen: list[int] = []
@@ -90,7 +94,7 @@ def enumerate_solutions(problem: AssignmentProblem, *, max_nodes: int = DEFAULT_
             nodes += 1
             if nodes > max_nodes:
                 raise _NodeLimit
-            if deadline is not None and not nodes & 1023 and time.perf_counter() > deadline:
+            if deadline is not None and not nodes & 255 and time.perf_counter() > deadline:
                 raise _OutOfTime
             chosen.append(k)
             yield from search(covered | masks[k])

@@ -27,6 +27,7 @@ any other key is set on CP-SAT's ``SatParameters`` by name (``max_number_of_conf
 
 from __future__ import annotations
 
+import dataclasses
 import math
 import time
 from typing import Any
@@ -34,14 +35,15 @@ from typing import Any
 import numpy as np
 
 from ..runtime.errors import InvalidProblemError
-from ..model.formulation import build_model
+from ..model.formulation import LinearModel, build_model
 from ..problems.problem import AssignmentProblem
 from ..model.solution import Status, relative_gap
 from .base import Backend, Option, RawResult, SolveOptions, register, remaining
 from .interruptible import run_cancellable
+from .limited import ISOLATE, killed_at_limit, run_limited
 from .status import from_table, settle_optimal
 
-__all__ = ["CpSatBackend"]
+__all__ = ["CpSatBackend", "run_model"]
 
 #: Scaled objective magnitudes stay below this (integers exact in float64).
 _MAX_SCALED_TOTAL = 1e15
@@ -128,6 +130,58 @@ def _apply_parameters(params: Any, options: SolveOptions, extra: dict[str, Any])
                 f"ortools-cpsat option {key}={value!r} was rejected: {exc}") from exc
 
 
+def run_model(model: LinearModel, icosts: np.ndarray, options: SolveOptions, *,
+              time_limit: float | None = None) -> dict[str, Any]:
+    """Fill a CP-SAT model with ``model``'s rows and the integer costs ``icosts`` and
+    solve it in this process; what the result needs, as plain values (the same in a
+    child process, :mod:`.limited`).  ``time_limit`` replaces the options' limit (what
+    is left of it)."""
+    from ortools.sat.python import cp_model
+
+    t0 = time.perf_counter()
+    if time_limit is not None:
+        options = dataclasses.replace(options, time_limit=time_limit)
+    A, K, n_rows = model.A, model.shape[1], model.shape[0]
+    cp = cp_model.CpModel()
+    proto = cp.proto
+    # Variables: one template proto copied K times.  Measured for K = 27 000 /
+    # 1 000 000: extend 7 ms / 0.65 s; merge_text_format 17 ms / 1.0 s;
+    # new_bool_var loop 72 ms / 4.2 s (new_bool_var_series is that loop in pandas).
+    template = cp.new_bool_var("")
+    proto.variables.extend([proto.variables[template.index]] * (K - 1))
+    # Objective straight into the proto: the equivalent of LinearExpr.weighted_sum
+    # without K Python variable objects (3 ms vs 60 ms for K = 27 000).
+    proto.objective.vars.extend(np.arange(K, dtype=np.int64))
+    proto.objective.coeffs.extend(icosts)
+    indptr, indices = A.indptr, A.indices.astype(np.int64)
+    for r in range(n_rows):           # one exactly-one constraint per coverage row
+        proto.constraints.add().exactly_one.literals.extend(indices[indptr[r]:indptr[r + 1]])
+
+    solver = cp_model.CpSolver()
+    _apply_parameters(solver.parameters, remaining(options, t0), dict(options.extra))
+    t1 = time.perf_counter()
+    # in a worker thread: Ctrl-C calls stop_search and CP-SAT returns at once; so
+    # does the deadline (CP-SAT's own clock is not looked at in every phase)
+    native, _ = run_cancellable(solver.solve, (cp,), solver.stop_search, deadline=None
+                                if options.time_limit is None else t0 + options.time_limit)
+    t2 = time.perf_counter()
+    response = solver.response_proto
+    name = native.name
+    has_solution = name in ("OPTIMAL", "FEASIBLE")
+    values = np.fromiter(response.solution, dtype=np.int64, count=K) if has_solution \
+        else None
+    return {"status": name, "fill_time": t1 - t0, "solve_time": t2 - t1,
+            "selected": None if values is None else np.flatnonzero(values > 0),
+            "objective": float(response.objective_value),
+            "bound": float(response.best_objective_bound),
+            "num_workers": int(solver.parameters.num_workers),
+            "random_seed": int(solver.parameters.random_seed),
+            "num_conflicts": int(response.num_conflicts),
+            "num_branches": int(response.num_branches),
+            "wall_time": float(response.wall_time),
+            "invalid": cp.validate() if name == "MODEL_INVALID" else ""}
+
+
 @register
 class CpSatBackend(Backend):
     """OR-Tools CP-SAT (clause learning + LP + portfolio search) on scaled integer costs."""
@@ -144,6 +198,7 @@ class CpSatBackend(Backend):
                "1 for integer costs, else the largest safe power of ten",
                low=0.0, low_open=True, high=math.inf, high_open=True, choices=("auto",)),
         Option("seed", "int", 0, "CP-SAT random_seed (reproducible with threads=1)"),
+        ISOLATE,
     )
     native_options = "any CP-SAT SatParameters field by name (max_number_of_conflicts=...)"
 
@@ -155,78 +210,62 @@ class CpSatBackend(Backend):
         return name in sat_parameters_pb2.SatParameters.DESCRIPTOR.fields_by_name
 
     def solve(self, problem: AssignmentProblem, options: SolveOptions) -> RawResult:
-        from ortools.sat.python import cp_model
-
         extra = self.settings(problem, options)
         scale_opt = extra.pop("scale")
+        isolate = extra.pop("isolate", None)
         t0 = time.perf_counter()
+        start = time.monotonic()
         model = build_model(problem, options.relax)
-        A, K, n_rows = model.A, model.shape[1], model.shape[0]
+        n_rows = model.shape[0]
         scale, icosts, max_err = _scaled_costs(model.c, n_rows, scale_opt)
-
-        cp = cp_model.CpModel()
-        proto = cp.proto
-        # Variables: one template proto copied K times.  Measured for K = 27 000 /
-        # 1 000 000: extend 7 ms / 0.65 s; merge_text_format 17 ms / 1.0 s;
-        # new_bool_var loop 72 ms / 4.2 s (new_bool_var_series is that loop in pandas).
-        template = cp.new_bool_var("")
-        proto.variables.extend([proto.variables[template.index]] * (K - 1))
-        # Objective straight into the proto: the equivalent of LinearExpr.weighted_sum
-        # without K Python variable objects (3 ms vs 60 ms for K = 27 000).
-        proto.objective.vars.extend(np.arange(K, dtype=np.int64))
-        proto.objective.coeffs.extend(icosts)
-        indptr, indices = A.indptr, A.indices.astype(np.int64)
-        for r in range(n_rows):           # one exactly-one constraint per coverage row
-            proto.constraints.add().exactly_one.literals.extend(indices[indptr[r]:indptr[r + 1]])
-
-        solver = cp_model.CpSolver()
-        _apply_parameters(solver.parameters, remaining(options, t0), extra)
+        sub = SolveOptions(relax=options.relax, time_limit=options.time_limit,
+                           mip_gap=options.mip_gap, threads=options.threads,
+                           verbose=options.verbose, extra=extra, parsed=True)
         t1 = time.perf_counter()
-        # in a worker thread: Ctrl-C calls stop_search and CP-SAT returns at once; so
-        # does the deadline (CP-SAT's own clock is not looked at in every phase)
-        native, _ = run_cancellable(solver.solve, (cp,), solver.stop_search, deadline=None
-                                    if options.time_limit is None else t0 + options.time_limit)
-        t2 = time.perf_counter()
-
-        response = solver.response_proto
-        name = native.name
+        if options.time_limit is not None and isolate is not False:
+            out = run_limited("assocopt.solvers.ortools_cpsat:run_model",
+                              (model, icosts, sub), options.time_limit, start)
+            if out is None:
+                return killed_at_limit(self.name, options.time_limit, t1 - t0,
+                                       time.perf_counter() - t1)
+        else:
+            out = run_model(model, icosts, sub, time_limit=remaining(options, t0).time_limit)
+        name = out["status"]
         info: dict[str, Any] = {
             "cpsat_status": name, "cpsat_scale": scale, "max_rounding_error": max_err,
-            "num_workers": int(solver.parameters.num_workers),
+            "num_workers": out["num_workers"],
             "num_workers_source": ("threads" if options.threads is not None else
                                    "option" if "num_workers" in options.extra else
                                    "assocopt default (CP-SAT's portfolio needs several "
                                    "workers even on small machines)"),
-            "random_seed": int(solver.parameters.random_seed),
-            "num_conflicts": int(response.num_conflicts),
-            "num_branches": int(response.num_branches),
-            "cpsat_wall_time": float(response.wall_time),
+            "random_seed": out["random_seed"], "num_conflicts": out["num_conflicts"],
+            "num_branches": out["num_branches"], "cpsat_wall_time": out["wall_time"],
         }
-        result = RawResult(status=Status.ERROR, info=info, build_time=t1 - t0,
-                           solve_time=t2 - t1)
-        has_solution = name in ("OPTIMAL", "FEASIBLE")
-        if has_solution:
-            values = np.fromiter(response.solution, dtype=np.int64, count=K)
-            result.selected = np.flatnonzero(values > 0)
-            info["cpsat_objective"] = float(response.objective_value)
-            info["cpsat_bound"] = float(response.best_objective_bound)
+        if "startup" in out:
+            info["isolated"] = round(out["startup"], 4)
+        # the proto's filling counts as building, as it did in this process
+        result = RawResult(status=Status.ERROR, info=info,
+                           build_time=t1 - t0 + out["fill_time"], solve_time=out["solve_time"])
+        if out["selected"] is not None:
+            result.selected = out["selected"]
+            info["cpsat_objective"] = out["objective"]
+            info["cpsat_bound"] = out["bound"]
             # Bound on the scaled problem -> valid bound on the original costs.
-            result.bound = (float(response.best_objective_bound) / scale
-                            - n_rows * max_err)
-        result.status, result.message = self._status(name, response, max_err, options, cp)
+            result.bound = out["bound"] / scale - n_rows * max_err
+        result.status, result.message = self._status(name, out, max_err, options)
         return result
 
     @staticmethod
-    def _status(name: str, response: Any, max_err: float, options: SolveOptions,
-                cp: Any) -> tuple[Status, str]:
+    def _status(name: str, out: dict[str, Any], max_err: float,
+                options: SolveOptions) -> tuple[Status, str]:
         """Map CP-SAT's status through ``_STATUS_TABLE``, then refine OPTIMAL."""
         status = from_table(_STATUS_TABLE, name)
         message = f"CP-SAT: {name}"
         if name == "MODEL_INVALID":
-            return status, f"CP-SAT: model invalid: {cp.validate()}"
+            return status, f"CP-SAT: model invalid: {out['invalid']}"
         if status is not Status.OPTIMAL:
             return status, message
-        gap = relative_gap(float(response.objective_value), float(response.best_objective_bound))
+        gap = relative_gap(out["objective"], out["bound"])
         if max_err > 0.0:
             return Status.FEASIBLE, (
                 f"CP-SAT: optimal for costs rounded to 1/scale (max rounding error "

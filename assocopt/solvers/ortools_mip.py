@@ -25,6 +25,8 @@ from __future__ import annotations
 
 import contextlib
 import ctypes
+import dataclasses
+import math
 import os
 import sys
 import time
@@ -33,14 +35,15 @@ from typing import Any, Iterator
 import numpy as np
 
 from ..runtime.errors import InvalidProblemError, SolverNotInstalledError
-from ..model.formulation import build_model
+from ..model.formulation import LinearModel, build_model
 from ..problems.problem import AssignmentProblem
 from ..model.solution import Status, relative_gap
 from .base import Backend, Option, RawResult, SolveOptions, register, remaining
 from .interruptible import run_cancellable
+from .limited import ISOLATE, killed_at_limit, run_limited
 from .status import from_table, settle_optimal
 
-__all__ = ["OrtoolsMipBackend"]
+__all__ = ["OrtoolsMipBackend", "run_model"]
 
 _MIP_BACKENDS = ("scip", "cbc", "highs", "sat", "gurobi", "xpress")
 _LP_BACKENDS = ("glop", "pdlp", "clp", "highs", "scip", "gurobi", "xpress")
@@ -129,6 +132,53 @@ def _parameter_text(backend: str, options: SolveOptions, is_mip: bool,
     return sep.join(parts), passed
 
 
+def run_model(model: LinearModel, backend: str, text: str, options: SolveOptions, *,
+              time_limit: float | None = None) -> dict[str, Any]:
+    """Solve ``model`` with OR-Tools' ``backend`` (parameter text ``text``) in this
+    process; what the result needs, as plain values (the same in a child process,
+    :mod:`.limited`).  ``time_limit`` replaces the options' limit (what is left)."""
+    from ortools.linear_solver.python import model_builder_helper as mbh
+
+    t0 = time.perf_counter()
+    if time_limit is not None:
+        options = dataclasses.replace(options, time_limit=time_limit)
+    with _silenced(not options.verbose):      # Gurobi/Xpress look-ups log to stderr
+        solver = mbh.ModelSolverHelper(backend)
+    helper = mbh.ModelBuilderHelper()
+    helper.fill_model_from_sparse_data(model.lb, model.ub, model.c, model.row_lower,
+                                       model.row_upper, model.A)
+    if model.is_mip:
+        # fill_model_from_sparse_data makes continuous variables and 9.15 has no
+        # bulk integrality setter; add_var_array_with_bounds has one but then the
+        # rows need one Python Variable object per nonzero.  Measured, K = 27 000 /
+        # 1 000 000: this loop 16 ms / 0.44 s, the fill itself 9 ms / 0.30 s.
+        for k in range(model.shape[1]):
+            helper.set_var_integrality(k, True)
+    solver.enable_output(bool(options.verbose))
+    if options.time_limit is not None:       # what is left after filling the model
+        solver.set_time_limit_in_seconds(float(remaining(options, t0).time_limit))
+    if text:
+        solver.set_solver_specific_parameters(text)
+    t1 = time.perf_counter()
+    with _silenced(not options.verbose):
+        # at the deadline the solve is interrupted from outside too: the solver's
+        # own clock is not looked at in every phase (SCIP's presolve)
+        _, by_clock = run_cancellable(solver.solve, (helper,), solver.interrupt_solve,
+                                      deadline=None if options.time_limit is None
+                                      else t0 + options.time_limit)
+    t2 = time.perf_counter()
+    detail = solver.status_string() if solver.has_response() else ""
+    if "SCIP status code 10" in detail and not by_clock:
+        raise KeyboardInterrupt           # SCIP_STATUS_USERINTERRUPT: SCIP caught Ctrl-C
+    has = solver.has_solution()
+    return {"status": solver.status().name, "detail": detail,
+            "fill_time": t1 - t0, "solve_time": t2 - t1,
+            "x": np.asarray(solver.variable_values(), dtype=np.float64) if has else None,
+            "objective": float(solver.objective_value()) if has else math.nan,
+            "bound": float(solver.best_objective_bound()) if has and model.is_mip
+            else math.nan}
+
+
 @register
 class OrtoolsMipBackend(Backend):
     """OR-Tools model_builder: SCIP branch and cut for the ILP, GLOP simplex for the LP."""
@@ -145,6 +195,7 @@ class OrtoolsMipBackend(Backend):
                choices=tuple(dict.fromkeys(_MIP_BACKENDS + _LP_BACKENDS)), nullable=True),
         Option("parameters", "str", "", "solver-specific parameter text appended to "
                "what assocopt sets"),
+        ISOLATE,
     )
 
     def solve(self, problem: AssignmentProblem, options: SolveOptions) -> RawResult:
@@ -154,6 +205,7 @@ class OrtoolsMipBackend(Backend):
         extra = self.settings(problem, options)
         backend = extra["backend"] or ("scip" if is_mip else "glop")
         user_text = extra["parameters"]
+        isolate = extra.get("isolate")
         allowed = _MIP_BACKENDS if is_mip else _LP_BACKENDS
         if backend not in allowed:
             raise InvalidProblemError(
@@ -169,36 +221,23 @@ class OrtoolsMipBackend(Backend):
                 "(or its library is not installed)")
 
         t0 = time.perf_counter()
+        start = time.monotonic()
         model = build_model(problem, options.relax)
-        helper = mbh.ModelBuilderHelper()
-        helper.fill_model_from_sparse_data(model.lb, model.ub, model.c, model.row_lower,
-                                           model.row_upper, model.A)
-        if is_mip:
-            # fill_model_from_sparse_data makes continuous variables and 9.15 has no
-            # bulk integrality setter; add_var_array_with_bounds has one but then the
-            # rows need one Python Variable object per nonzero.  Measured, K = 27 000 /
-            # 1 000 000: this loop 16 ms / 0.44 s, the fill itself 9 ms / 0.30 s.
-            for k in range(model.shape[1]):
-                helper.set_var_integrality(k, True)
         text, passed = _parameter_text(backend, options, is_mip, user_text)
-        solver.enable_output(bool(options.verbose))
-        if options.time_limit is not None:       # what is left after building the model
-            solver.set_time_limit_in_seconds(float(remaining(options, t0).time_limit))
-        if text:
-            solver.set_solver_specific_parameters(text)
+        sub = SolveOptions(relax=options.relax, time_limit=options.time_limit,
+                           mip_gap=options.mip_gap, threads=options.threads,
+                           verbose=options.verbose, parsed=True)
         t1 = time.perf_counter()
-        with _silenced(not options.verbose):
-            # at the deadline the solve is interrupted from outside too: the solver's
-            # own clock is not looked at in every phase (SCIP's presolve)
-            _, by_clock = run_cancellable(solver.solve, (helper,), solver.interrupt_solve,
-                                          deadline=None if options.time_limit is None
-                                          else t0 + options.time_limit)
-        t2 = time.perf_counter()
-
-        native = solver.status().name
-        detail = solver.status_string() if solver.has_response() else ""
-        if "SCIP status code 10" in detail and not by_clock:
-            raise KeyboardInterrupt           # SCIP_STATUS_USERINTERRUPT: SCIP caught Ctrl-C
+        if options.time_limit is not None and isolate is not False:
+            out = run_limited("assocopt.solvers.ortools_mip:run_model",
+                              (model, backend, text, sub), options.time_limit, start)
+            if out is None:
+                return killed_at_limit(self.name, options.time_limit, t1 - t0,
+                                       time.perf_counter() - t1)
+        else:
+            out = run_model(model, backend, text, sub,
+                            time_limit=remaining(options, t0).time_limit)
+        native, detail = out["status"], out["detail"]
         if native == "INVALID_SOLVER_PARAMETERS" and user_text:
             raise InvalidProblemError(
                 f"ortools-mip backend {backend!r} rejected the parameters {user_text!r}: "
@@ -206,21 +245,24 @@ class OrtoolsMipBackend(Backend):
         info: dict[str, Any] = {"ortools_status": native, "ortools_backend": backend,
                                 "mip_gap_passed": passed["mip_gap"],
                                 "threads_passed": passed["threads"]}
-        result = RawResult(status=Status.ERROR, build_time=t1 - t0, solve_time=t2 - t1,
-                           info=info)
+        if "startup" in out:
+            info["isolated"] = round(out["startup"], 4)
+        result = RawResult(status=Status.ERROR, build_time=t1 - t0 + out["fill_time"],
+                           solve_time=out["solve_time"], info=info)
         objective = bound = None
-        if solver.has_solution():
-            x = np.asarray(solver.variable_values(), dtype=np.float64)
-            objective = float(solver.objective_value())
+        x = out["x"]
+        if x is not None:
+            objective = out["objective"]
             if is_mip:
                 result.selected = np.flatnonzero(x > 0.5)
-                best = float(solver.best_objective_bound())
-                if np.isfinite(best):
-                    bound = result.bound = best
+                if np.isfinite(out["bound"]):
+                    bound = result.bound = out["bound"]
             else:
                 result.x = x
                 result.objective = objective
-        result.status, note = self._status(native, objective, bound, options, t2 - t1)
+        # the limit counts from t0 (in a child too, where the model was filled again)
+        result.status, note = self._status(native, objective, bound, options,
+                                           time.perf_counter() - t0)
         result.message = f"OR-Tools {backend}: {native}" + (f" ({detail})" if detail else "")
         if note:
             result.message += f"; {note}"
