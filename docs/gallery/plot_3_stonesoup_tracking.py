@@ -73,5 +73,5 @@ plt.show()
 # %%
 # For multiple-hypothesis tracking, :class:`~assocopt.tracking.stonesoup.AssocoptKBest`
 # returns the k best joint hypotheses of a scan (Murty's ranking), best first.
-ranked = AssocoptKBest(hypothesiser, k=3).associate(set(tracks), detections, t)
+ranked = AssocoptKBest(hypothesiser, k=3).rank(set(tracks), detections, t)
 print([round(float(joint.distance), 2) for joint in ranked])
