@@ -17,6 +17,7 @@ import sys
 from pathlib import Path
 from typing import Any, Callable
 
+import numpy as np
 import pytest
 from hypothesis import strategies as st
 
@@ -135,6 +136,20 @@ def sd_problems(draw, dummies=None):
     return AssignmentProblem.dense(draw_costs(draw, shape, integer))
 
 
+def draw_misses(draw, rng: np.random.Generator, n: int, none: Any) -> Any:
+    """Miss costs of ``n`` rows or columns of a drawn 2-D problem, of a drawn kind:
+    ``none`` (returned as given: no misses), finite, some forbidden (inf) or all zero."""
+    kind = draw(st.sampled_from(["none", "finite", "some-inf", "zero"]))
+    if kind == "none":
+        return none
+    m = rng.integers(-3, 8, size=n).astype(float)
+    if kind == "zero":
+        m[:] = 0.0
+    if kind == "some-inf" and n:
+        m[rng.random(n) < 0.5] = np.inf
+    return m
+
+
 def page_block(text: str, name: str) -> str:
     """The generated block ``name`` of a docs page (between its begin/end markers)."""
     m = re.search(rf"<!-- {name}:begin -->\n(.*?)\n<!-- {name}:end -->", text, re.DOTALL)
@@ -158,13 +173,21 @@ def check_page_against_summary(repro, paper: str, page: Path, summary_path: Path
     return summary
 
 
-def load_script(path: str, name: str):
+def load_script(path: str, name: str, register: bool = False):
     """The repository script ``path`` (relative to the checkout, e.g.
-    ``"benchmarks/twod.py"``) executed as a fresh module called ``name``."""
+    ``"benchmarks/twod.py"``) executed as a fresh module called ``name``; ``register``:
+    entered in ``sys.modules`` first (a script defining dataclasses needs that)."""
     spec = importlib.util.spec_from_file_location(name, ROOT / path)
     mod = importlib.util.module_from_spec(spec)
+    if register:
+        sys.modules[name] = mod
     spec.loader.exec_module(mod)
     return mod
+
+
+def agrees(a: float, b: float) -> bool:
+    """``a`` and ``b`` equal to a relative 1e-6 (numbers read back from a page or JSON)."""
+    return abs(a - b) <= 1e-6 * max(1.0, abs(a), abs(b))
 
 
 def rerun_committed(repro, paper: str, part: str, where: Callable[[dict], bool],

@@ -10,13 +10,11 @@ import json
 import math
 import re
 import statistics
-from pathlib import Path
 
 import pytest
 
-from conftest import load_script
+from conftest import ROOT, load_script
 
-ROOT = Path(__file__).resolve().parents[1]
 JSON = ROOT / "docs" / "benchmarks.json"
 PAGE = ROOT / "docs" / "benchmarks.md"
 

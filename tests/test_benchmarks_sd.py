@@ -5,19 +5,15 @@ ratios of the totals shown; README.md's S-D figures are the ones in the JSON."""
 
 from __future__ import annotations
 
-import importlib.util
 import json
 import math
 import re
-import sys
-from pathlib import Path
 
 import numpy as np
 import pytest
 
-from conftest import load_script
+from conftest import ROOT, agrees, load_script
 
-ROOT = Path(__file__).resolve().parents[1]
 JSON = ROOT / "docs" / "benchmarks-sd.json"
 PAGE = ROOT / "docs" / "benchmarks-sd.md"
 PNG = ROOT / "docs" / "benchmarks-sd.png"
@@ -28,22 +24,12 @@ def _page_mod():
 
 
 def _scaling_mod():
-    """benchmarks/sd_scaling.py as a module, registered in sys.modules (its dataclasses
-    need that)."""
-    spec = importlib.util.spec_from_file_location("bench_sd_scaling",
-                                                  ROOT / "benchmarks" / "sd_scaling.py")
-    mod = importlib.util.module_from_spec(spec)
-    sys.modules[spec.name] = mod
-    spec.loader.exec_module(mod)
-    return mod
+    """benchmarks/sd_scaling.py as a module (registered: its dataclasses need that)."""
+    return load_script("benchmarks/sd_scaling.py", "bench_sd_scaling", register=True)
 
 
 def _data() -> dict:
     return json.loads(JSON.read_text())
-
-
-def _agrees(a: float, b: float) -> bool:
-    return abs(a - b) <= 1e-6 * max(1.0, abs(a), abs(b))
 
 
 def test_page_matches_the_committed_json():
@@ -67,9 +53,9 @@ def test_every_proven_objective_is_the_recorded_optimum():
         ref = row["optimum"] if row["optimum"] is not None else row["reference"]
         for name, r in row["results"].items():
             if r["status"] == "optimal":
-                assert ref is not None and _agrees(r["objective"], ref), (row["name"], name)
+                assert ref is not None and agrees(r["objective"], ref), (row["name"], name)
             assert r["info"]["correct"] == (r["status"] != "optimal" or ref is None
-                                            or _agrees(r["objective"], ref))
+                                            or agrees(r["objective"], ref))
 
 
 def test_our_exact_methods_prove_every_instance():

@@ -6,15 +6,11 @@ README.md's tracking figures are the ones in the JSON."""
 
 from __future__ import annotations
 
-import importlib.util
 import json
 import re
-import sys
-from pathlib import Path
 
-from conftest import load_script
+from conftest import ROOT, agrees, load_script
 
-ROOT = Path(__file__).resolve().parents[1]
 JSON = ROOT / "docs" / "benchmarks-tracking.json"
 PAGE = ROOT / "docs" / "benchmarks-tracking.md"
 
@@ -25,10 +21,6 @@ def _page_mod():
 
 def _data() -> dict:
     return json.loads(JSON.read_text())
-
-
-def _agrees(a: float, b: float) -> bool:
-    return abs(a - b) <= 1e-6 * max(1.0, abs(a), abs(b))
 
 
 def test_page_matches_the_committed_json():
@@ -42,12 +34,12 @@ def test_json_records_the_environment_and_the_command():
     assert env["minutes"] > 0 and re.fullmatch(r"\d{4}-\d\d-\d\d", env["date"])
 
 
-def test_every_proven_objective_agrees():
+def test_every_proven_objectiveagrees():
     scans = _data()["scans"]
     assert scans
     for row in scans:
         for name, r in row["results"].items():
-            ok = r["status"] != "optimal" or _agrees(r["objective"], row["reference"])
+            ok = r["status"] != "optimal" or agrees(r["objective"], row["reference"])
             assert r["correct"] == ok, (row["spec"], name)
             if name != "milp":                 # our solves prove every scan
                 assert r["status"] == "optimal" and ok, (row["spec"], name)
@@ -90,11 +82,7 @@ def test_totals_and_ratios_are_those_of_the_scan_times():
 def test_scans_are_the_generators():
     """The committed scans' sizes are what benchmarks/tracking_scans.py draws today
     (a changed generator would make the page describe other scans)."""
-    spec = importlib.util.spec_from_file_location("bench_tracking_scans",
-                                                  ROOT / "benchmarks" / "tracking_scans.py")
-    gen = importlib.util.module_from_spec(spec)
-    sys.modules[spec.name] = gen           # its dataclass needs the module registered
-    spec.loader.exec_module(gen)
+    gen = load_script("benchmarks/tracking_scans.py", "bench_tracking_scans", register=True)
     small = sorted(_data()["scans"], key=lambda r: r["K"])[:3]
     for row in small:
         p, _ = gen.build_problem(gen.ScanSpec(**row["spec"]))

@@ -60,6 +60,18 @@ def bad_input(capsys, path, *argv, words=()) -> str:
     return one_line(err, str(path), *words)
 
 
+def bad_file(capsys, path: Path, content: str | bytes, command: str,
+             words: tuple[str, ...]) -> Path:
+    """``path`` written with ``content``: ``assocopt COMMAND path`` rejects it
+    (:func:`bad_input`)."""
+    if isinstance(content, bytes):
+        path.write_bytes(content)
+    else:
+        path.write_text(content)
+    bad_input(capsys, path, command, path, words=words)
+    return path
+
+
 def json_instance(path: Path, **doc) -> Path:
     path.write_text(json.dumps({"format": "assocopt-instance", "version": 1, **doc}))
     return path
@@ -255,21 +267,16 @@ class TestDetection:
     """A lone number is no 1x1x1 problem."""
 
     def test_truncated_orlib(self, tmp_path, capsys):
-        f = tmp_path / "assign100.txt"
-        f.write_text("100\n")
-        bad_input(capsys, f, "validate", f, words=("10000",))
+        f = bad_file(capsys, tmp_path / "assign100.txt", "100\n", "validate", ("10000",))
         with pytest.raises(Exception, match="10000"):
             read_instance(f)
 
     def test_lone_number(self, tmp_path, capsys):
-        f = tmp_path / "numbers.txt"
-        f.write_text("100\n")
-        bad_input(capsys, f, "solve", f, words=("cannot tell the format",))
+        bad_file(capsys, tmp_path / "numbers.txt", "100\n", "solve",
+                 ("cannot tell the format",))
 
     def test_json_scalar(self, tmp_path, capsys):
-        f = tmp_path / "answer.json"
-        f.write_text("42\n")
-        bad_input(capsys, f, "validate", f, words=("JSON object", "42"))
+        bad_file(capsys, tmp_path / "answer.json", "42\n", "validate", ("JSON object", "42"))
 
     def test_real_cube_still_detected(self, tmp_path):
         f = tmp_path / "cube.txt"
@@ -590,19 +597,16 @@ class TestAlreadyHandled:
     """The classes of bad input handled before this module: still one line each."""
 
     def test_truncated(self, tmp_path, capsys):
-        f = tmp_path / "ap3.2.1.txt"
-        f.write_text("3\n2 2 2\n1 2 3\n")
-        bad_input(capsys, f, "solve", f, words=("expected 8 costs, found 3",))
+        bad_file(capsys, tmp_path / "ap3.2.1.txt", "3\n2 2 2\n1 2 3\n", "solve",
+                 ("expected 8 costs, found 3",))
 
     def test_garbled(self, tmp_path, capsys):
-        f = tmp_path / "garbled.txt"
-        f.write_bytes(b"\x89PNG\r\n\x1a junk \xff\xfe")
-        bad_input(capsys, f, "solve", f, words=("not a UTF-8 text file",))
+        bad_file(capsys, tmp_path / "garbled.txt", b"\x89PNG\r\n\x1a junk \xff\xfe", "solve",
+                 ("not a UTF-8 text file",))
 
     def test_garbled_token(self, tmp_path, capsys):
-        f = tmp_path / "tok.txt"
-        f.write_text("3\n2 2 2\n1 2 3 4 5 6 seven 8\n")
-        bad_input(capsys, f, "validate", f, words=("seven",))
+        bad_file(capsys, tmp_path / "tok.txt", "3\n2 2 2\n1 2 3 4 5 6 seven 8\n", "validate",
+                 ("seven",))
 
     def test_wrong_version(self, tmp_path, capsys):
         f = json_instance(tmp_path / "v.json", kind="dense", costs=[[1]])

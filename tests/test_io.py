@@ -195,29 +195,38 @@ def test_bs_split_with_header(tmp_path):
                                   np.arange(8).reshape(2, 2, 2))
 
 
-def test_bs_split_header_count_mismatch(tmp_path):
-    f = write(tmp_path / "one.txt", "3 3\n" + "".join(f"{v}\n" for v in range(26)))
-    with pytest.raises(InstanceFormatError, match="expected 27 costs, found 26"):
-        read_instance(f)
+#: Text files read_instance refuses: (file name, text, format, the error's words).
+REJECTED = [
+    pytest.param("one.txt", "3 3\n" + "".join(f"{v}\n" for v in range(26)), "auto",
+                 "expected 27 costs, found 26", id="bs_split_header_count_mismatch"),
+    pytest.param("balas-n10-instance01.txt", "5\n" * 998, "auto",
+                 r"balas-n10-instance01\.txt: .*expected 1000 costs, found 998",
+                 id="bs_split_truncated_uses_name"),
+    pytest.param("x.txt", "5\n" * 10, "balas-saltzman-split",
+                 "found 10, which is not a cube", id="bs_split_not_a_cube_when_forced"),
+    pytest.param("balas-n3-instance01.txt", "5\n" * 8, "auto", "file name says n = 3",
+                 id="bs_split_name_disagrees"),
+    pytest.param("assign3.txt", "3\n 7 5 9\n 2 8 4\n 6 3\n", "auto",
+                 r"assign3\.txt: .*expected 9 costs, found 8", id="orlib_truncated"),
+    pytest.param("a.txt", "2\n1 2 3 4 5\n", "orlib", "expected 4 costs, found 5",
+                 id="orlib_extra_numbers"),
+    pytest.param("notes.txt", "hello world\n", "auto",
+                 r"notes\.txt: unknown format: non-numeric token 'hello'", id="unknown_text"),
+    pytest.param("nums.txt", "1 2 3\n4 5 6 7\n", "auto",
+                 r"nums\.txt: unknown format \(2 non-blank lines, 7 numbers",
+                 id="unknown_numeric_layout"),
+    # one number per line, 2 numbers: an OR-Library header or a Balas-Saltzman
+    # split file, and the count fits neither
+    pytest.param("two.txt", "5\n7\n", "auto",
+                 r"two\.txt: cannot tell the format: the layout fits "
+                 r".*balas-saltzman-split.*orlib", id="ambiguous_layout"),
+]
 
 
-def test_bs_split_truncated_uses_name(tmp_path):
-    f = write(tmp_path / "balas-n10-instance01.txt", "".join("5\n" for _ in range(998)))
-    with pytest.raises(InstanceFormatError,
-                       match=r"balas-n10-instance01\.txt: .*expected 1000 costs, found 998"):
-        read_instance(f)
-
-
-def test_bs_split_not_a_cube_when_forced(tmp_path):
-    f = write(tmp_path / "x.txt", "".join("5\n" for _ in range(10)))
-    with pytest.raises(InstanceFormatError, match="found 10, which is not a cube"):
-        read_instance(f, format="balas-saltzman-split")
-
-
-def test_bs_split_name_disagrees(tmp_path):
-    f = write(tmp_path / "balas-n3-instance01.txt", "".join("5\n" for _ in range(8)))
-    with pytest.raises(InstanceFormatError, match="file name says n = 3"):
-        read_instance(f)
+@pytest.mark.parametrize("name, text, fmt, words", REJECTED)
+def test_rejected_text(tmp_path, name, text, fmt, words):
+    with pytest.raises(InstanceFormatError, match=words):
+        read_instance(write(tmp_path / name, text), format=fmt)
 
 
 # ------------------------------------------------------------------ OR-Library
@@ -237,18 +246,6 @@ def test_orlib_wrapped_rows(tmp_path):
     assert read_instance(f).to_cost_matrix().tolist() == [[1, 2], [3, 4]]
 
 
-def test_orlib_truncated(tmp_path):
-    f = write(tmp_path / "assign3.txt", "3\n 7 5 9\n 2 8 4\n 6 3\n")
-    with pytest.raises(InstanceFormatError, match=r"assign3\.txt: .*expected 9 costs, found 8"):
-        read_instance(f)
-
-
-def test_orlib_extra_numbers(tmp_path):
-    f = write(tmp_path / "a.txt", "2\n1 2 3 4 5\n")
-    with pytest.raises(InstanceFormatError, match="expected 4 costs, found 5"):
-        read_instance(f, format="orlib")
-
-
 # ------------------------------------------------------------------ detection / generic
 def test_empty_file(tmp_path):
     for name, text in (("e.txt", ""), ("w.json", "  \n\n")):
@@ -265,27 +262,6 @@ def test_binary_file(tmp_path):
     g.write_bytes(b"3\n\xff\xfe\n")
     with pytest.raises(InstanceFormatError, match="not a UTF-8 text file"):
         read_instance(g)
-
-
-def test_unknown_text(tmp_path):
-    f = write(tmp_path / "notes.txt", "hello world\n")
-    with pytest.raises(InstanceFormatError, match=r"notes\.txt: unknown format: non-numeric token 'hello'"):
-        read_instance(f)
-
-
-def test_unknown_numeric_layout(tmp_path):
-    f = write(tmp_path / "nums.txt", "1 2 3\n4 5 6 7\n")
-    with pytest.raises(InstanceFormatError, match=r"nums\.txt: unknown format \(2 non-blank lines, 7 numbers"):
-        read_instance(f)
-
-
-def test_ambiguous_layout(tmp_path):
-    # one number per line, 2 numbers: an OR-Library header or a Balas-Saltzman
-    # split file, and the count fits neither
-    f = write(tmp_path / "two.txt", "5\n7\n")
-    with pytest.raises(InstanceFormatError,
-                       match=r"two\.txt: cannot tell the format: the layout fits .*balas-saltzman-split.*orlib"):
-        read_instance(f)
 
 
 def test_bad_format_argument_and_instance_for_single(tmp_path):

@@ -7,8 +7,10 @@ autouse fixture of conftest.py checks that no child process outlives its test.
 
 from __future__ import annotations
 
-import _thread
+import signal
+import subprocess
 import threading
+from types import SimpleNamespace
 
 import numpy as np
 import pytest
@@ -67,14 +69,33 @@ def test_a_child_still_running_at_the_deadline_is_killed(solver, hard, monkeypat
 
 
 @pytest.mark.parametrize("solver", ISOLATED)
-def test_ctrl_c_kills_the_child(solver, hard, sigint_python):
-    timer = threading.Timer(0.5, _thread.interrupt_main)
-    timer.start()
+def test_ctrl_c_kills_the_child(solver, hard, sigint_python, monkeypatch):
+    """A real SIGINT to the main thread (what Ctrl-C sends) half a second after the
+    child started: the parent stops waiting at once and kills the child, which was
+    still solving (exit status -SIGKILL, not 0 after an answer).
+
+    ``_thread.interrupt_main()`` would not do: it interrupts no system call, so the
+    parent raised only once the child had finished the solve (minutes, under load)."""
+    children: list[subprocess.Popen] = []
+    timers: list[threading.Timer] = []
+
+    def popen(*args, **kwargs) -> subprocess.Popen:
+        proc = subprocess.Popen(*args, **kwargs)
+        children.append(proc)
+        timers.append(threading.Timer(0.5, signal.pthread_kill,
+                                      (threading.main_thread().ident, signal.SIGINT)))
+        timers[-1].start()
+        return proc
+
+    monkeypatch.setattr(limited, "subprocess", SimpleNamespace(
+        Popen=popen, PIPE=subprocess.PIPE, TimeoutExpired=subprocess.TimeoutExpired))
     try:
         with pytest.raises(KeyboardInterrupt):
             solve(hard, solver, time_limit=600.0)
     finally:
-        timer.cancel()
+        for timer in timers:
+            timer.cancel()
+    assert len(children) == 1 and children[0].returncode == -signal.SIGKILL
 
 
 def test_an_error_in_the_child_is_raised_here():

@@ -12,6 +12,7 @@ from assocopt import AssignmentProblem, Status, solve
 from assocopt.solvers import sparse2d
 from assocopt.solvers.lap import LapInfeasibleError
 from assocopt.solvers.sparse2d import assign_sparse_edges
+from conftest import draw_misses
 
 
 @st.composite
@@ -38,17 +39,8 @@ def gated_cases(draw):
     if len(w):
         w[rng.random(len(w)) < draw(st.sampled_from([0.0, 0.25]))] = np.inf
 
-    def miss(n):
-        kind = draw(st.sampled_from(["none", "finite", "some-inf", "zero"]))
-        if kind == "none":
-            return np.full(n, np.inf)
-        m = rng.integers(-3, 8, size=n).astype(float)
-        if kind == "zero":
-            m[:] = 0.0
-        if kind == "some-inf" and n:
-            m[rng.random(n) < 0.5] = np.inf
-        return m
-    return n1, n2, rows, cols, w, miss(n1), miss(n2)
+    return (n1, n2, rows, cols, w, draw_misses(draw, rng, n1, np.full(n1, np.inf)),
+            draw_misses(draw, rng, n2, np.full(n2, np.inf)))
 
 
 def _problem(n1, n2, rows, cols, w, rm, cm) -> AssignmentProblem:

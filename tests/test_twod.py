@@ -9,6 +9,7 @@ from hypothesis import given, settings, strategies as st
 from assocopt import AssignmentProblem, Status, solve
 from assocopt.solvers.lap import lapx_available
 from assocopt.solvers.sparse2d import assign_sparse
+from conftest import draw_misses
 
 ENGINES = ["scipy-lsa"] + (["lapjv"] if lapx_available() else [])
 
@@ -23,17 +24,7 @@ def two_d_cases(draw):
     C = rng.integers(-5, 10, size=(n1, n2)).astype(float)
     C[rng.random((n1, n2)) < draw(st.sampled_from([0.0, 0.3]))] = np.inf
 
-    def miss(n):
-        kind = draw(st.sampled_from(["none", "finite", "some-inf", "zero"]))
-        if kind == "none":
-            return None
-        m = rng.integers(-3, 8, size=n).astype(float)
-        if kind == "zero":
-            m[:] = 0.0
-        if kind == "some-inf" and n:
-            m[rng.random(n) < 0.5] = np.inf
-        return m
-    return C, miss(n1), miss(n2)
+    return C, draw_misses(draw, rng, n1, None), draw_misses(draw, rng, n2, None)
 
 
 def _reference(p: AssignmentProblem):

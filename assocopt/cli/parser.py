@@ -126,6 +126,14 @@ def _add_input_args(p: argparse.ArgumentParser, formats: Sequence[str]) -> None:
                    help="instance in a multi-instance file: N20_P5, 20,5 or a 1-based position")
 
 
+def _add_prove_args(p: argparse.ArgumentParser) -> None:
+    """``--prove`` and its ``--time-limit`` (``generate`` and ``convert``)."""
+    p.add_argument("--prove", action="store_true",
+                   help="prove the optimum with HiGHS and record it")
+    p.add_argument("--time-limit", type=float, metavar="S", default=None,
+                   help="seconds for --prove")
+
+
 def _add_more_parsers(sub: Any, formats: Sequence[str]) -> None:
     from ..io.convert import CONVERT_FORMATS
     from ..workflow.generate import GENERATORS
@@ -202,10 +210,7 @@ def _add_more_parsers(sub: Any, formats: Sequence[str]) -> None:
                     help="sparse: detection probability (default 0.9)")
     pg.add_argument("--targets", type=int, default=None,
                     help="sparse: number of targets (default: the smallest size)")
-    pg.add_argument("--prove", action="store_true",
-                    help="prove the optimum with HiGHS and record it")
-    pg.add_argument("--time-limit", type=float, metavar="S", default=None,
-                    help="seconds for --prove")
+    _add_prove_args(pg)
 
     pk = sub.add_parser("convert", help="convert between instance formats",
                         description="Read IN (any supported format) and write OUT: the "
@@ -219,10 +224,7 @@ def _add_more_parsers(sub: Any, formats: Sequence[str]) -> None:
                          "assign*.txt, balas*)")
     pk.add_argument("--instance", metavar="I", default=None,
                     help="instance in a multi-instance file: N20_P5, 20,5 or a position")
-    pk.add_argument("--prove", action="store_true",
-                    help="prove the optimum with HiGHS and record it")
-    pk.add_argument("--time-limit", type=float, metavar="S", default=None,
-                    help="seconds for --prove")
+    _add_prove_args(pk)
 
     pi = sub.add_parser("instances", help="list stored instances",
                         description="List the instance files of DIR (default: ./instances, "

@@ -41,7 +41,7 @@ from ..model.solution import Status, relative_gap
 from .base import (Backend, Option, RawResult, SolveOptions, empty_answer, register,
                    remaining)
 from .interruptible import run_cancellable
-from .limited import ISOLATE, killed_at_limit, run_limited
+from .limited import ISOLATE, solve_isolated_or_here
 from .status import from_table, settle_optimal
 
 __all__ = ["CvxpyBackend"]
@@ -192,15 +192,11 @@ class CvxpyBackend(Backend):
         t_model = time.perf_counter()
         args = (model, extra["cvxpy_solver"], dict(extra["solver_options"]),
                 dataclasses.replace(options, extra={}, parsed=True))
-        if options.time_limit is not None and isolate is not False:
-            out = run_limited("assocopt.solvers.cvxpy_backend:run_model", args,
-                              options.time_limit, start)
-            if out is None:
-                return killed_at_limit(self.name, options.time_limit, 0.0,
-                                       time.perf_counter() - t0)
-        else:
-            out = run_model(*args, time_limit=options.time_limit and
-                            remaining(options, t0).time_limit)
+        # killed at the limit: all counts as solving (CVXPY's compilation is in the child)
+        out = solve_isolated_or_here(self.name, run_model, args, options, isolate,
+                                     start, t0, t0)
+        if isinstance(out, RawResult):
+            return out
         info: dict[str, Any] = {"cvxpy_solver": out["solver"],
                                 "limits_passed": out["limits_passed"]}
         if "startup" in out:

@@ -17,8 +17,8 @@ from ..runtime.errors import InvalidProblemError
 from ..model.formulation import LinearModel, build_model
 from ..problems.problem import AssignmentProblem
 from ..model.solution import Status
-from .base import Backend, RawResult, SolveOptions, empty_answer, register, remaining
-from .limited import ISOLATE, killed_at_limit, run_limited
+from .base import Backend, RawResult, SolveOptions, empty_answer, register
+from .limited import ISOLATE, solve_isolated_or_here
 from .status import from_table, settle_optimal
 
 __all__ = ["HighsBackend", "highs_from_model"]
@@ -157,14 +157,10 @@ class HighsBackend(Backend):
                            mip_gap=options.mip_gap, threads=options.threads,
                            verbose=options.verbose, extra=extra, parsed=True)
         t1 = time.perf_counter()
-        if options.time_limit is not None and isolate is not False:
-            out = run_limited("assocopt.solvers.highs:run_model", (model, sub),
-                              options.time_limit, start)
-            if out is None:
-                return killed_at_limit(self.name, options.time_limit, t1 - t0,
-                                       time.perf_counter() - t1)
-        else:
-            out = run_model(model, sub, time_limit=remaining(options, t0).time_limit)
+        out = solve_isolated_or_here(self.name, run_model, (model, sub), options, isolate,
+                                     start, t0, t1)
+        if isinstance(out, RawResult):
+            return out
         return self._result(out, model, options, t1 - t0)
 
     def _result(self, out: dict[str, Any], model: LinearModel, options: SolveOptions,

@@ -30,9 +30,10 @@ from pathlib import Path
 from typing import Any, Callable
 
 from ..model.solution import Status
-from .base import Option, RawResult
+from .base import Option, RawResult, SolveOptions, remaining
 
-__all__ = ["ISOLATE", "run_limited", "kill_slack", "killed_at_limit", "child_main"]
+__all__ = ["ISOLATE", "run_limited", "solve_isolated_or_here", "kill_slack",
+           "killed_at_limit", "child_main"]
 
 #: The option of the back ends that use this module.
 ISOLATE = Option("isolate", "bool", None,
@@ -84,6 +85,27 @@ def run_limited(target: str, args: tuple, limit: float, start: float) -> dict[st
         raise value
     value["startup"] = ready - spawned
     return value
+
+
+def solve_isolated_or_here(solver: str, fn: Callable[..., dict[str, Any]], args: tuple,
+                           options: SolveOptions, isolate: bool | None,
+                           start: float, t0: float, t1: float) -> dict[str, Any] | RawResult:
+    """``fn(*args, time_limit=...)`` (a module-level function of a back end) run under
+    the back end's ``isolate`` option: in a child process when a time limit is given
+    and ``isolate`` is not False (:func:`run_limited`; limit counted from ``start``, a
+    ``time.monotonic()`` value), else in this process with the limit less what has
+    passed since ``t0`` (``time.perf_counter()``, the start of building).
+
+    Returns ``fn``'s dict, or the :func:`killed_at_limit` answer (build time
+    ``t1 - t0``, ``t1`` the end of building) when the child was killed at the limit.
+    """
+    if options.time_limit is not None and isolate is not False:
+        out = run_limited(f"{fn.__module__}:{fn.__name__}", args, options.time_limit, start)
+        if out is None:
+            return killed_at_limit(solver, options.time_limit, t1 - t0,
+                                   time.perf_counter() - t1)
+        return out
+    return fn(*args, time_limit=remaining(options, t0).time_limit)
 
 
 def killed_at_limit(solver: str, limit: float, build_time: float,

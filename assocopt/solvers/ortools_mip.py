@@ -40,7 +40,7 @@ from ..problems.problem import AssignmentProblem
 from ..model.solution import Status, relative_gap
 from .base import Backend, Option, RawResult, SolveOptions, register, remaining
 from .interruptible import run_cancellable
-from .limited import ISOLATE, killed_at_limit, run_limited
+from .limited import ISOLATE, solve_isolated_or_here
 from .status import from_table, settle_optimal
 
 __all__ = ["OrtoolsMipBackend", "run_model"]
@@ -228,15 +228,10 @@ class OrtoolsMipBackend(Backend):
                            mip_gap=options.mip_gap, threads=options.threads,
                            verbose=options.verbose, parsed=True)
         t1 = time.perf_counter()
-        if options.time_limit is not None and isolate is not False:
-            out = run_limited("assocopt.solvers.ortools_mip:run_model",
-                              (model, backend, text, sub), options.time_limit, start)
-            if out is None:
-                return killed_at_limit(self.name, options.time_limit, t1 - t0,
-                                       time.perf_counter() - t1)
-        else:
-            out = run_model(model, backend, text, sub,
-                            time_limit=remaining(options, t0).time_limit)
+        out = solve_isolated_or_here(self.name, run_model, (model, backend, text, sub),
+                                     options, isolate, start, t0, t1)
+        if isinstance(out, RawResult):
+            return out
         native, detail = out["status"], out["detail"]
         if native == "INVALID_SOLVER_PARAMETERS" and user_text:
             raise InvalidProblemError(

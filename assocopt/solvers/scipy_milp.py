@@ -15,10 +15,9 @@ import numpy as np
 from ..model.formulation import LinearModel, build_model
 from ..problems.problem import AssignmentProblem
 from ..model.solution import Status
-from .base import (Backend, Option, RawResult, SolveOptions, empty_answer, register,
-                   remaining)
+from .base import Backend, Option, RawResult, SolveOptions, empty_answer, register
 from .interruptible import run_cancellable
-from .limited import ISOLATE, killed_at_limit, run_limited
+from .limited import ISOLATE, solve_isolated_or_here
 from .status import from_table, settle_optimal
 
 __all__ = ["ScipyMilpBackend"]
@@ -67,14 +66,10 @@ class ScipyMilpBackend(Backend):
             opts["presolve"] = False
         opts.update(extra)
         t1 = time.perf_counter()
-        if options.time_limit is not None and isolate is not False:
-            res = run_limited("assocopt.solvers.scipy_milp:run_model", (model, opts),
-                              options.time_limit, start)
-            if res is None:
-                return killed_at_limit(self.name, options.time_limit, t1 - t0,
-                                       time.perf_counter() - t1)
-        else:
-            res = run_model(model, opts, time_limit=remaining(options, t0).time_limit)
+        res = solve_isolated_or_here(self.name, run_model, (model, opts), options, isolate,
+                                     start, t0, t1)
+        if isinstance(res, RawResult):
+            return res
         t2 = time.perf_counter()
         status, _ = settle_optimal(from_table(_STATUS_TABLE, str(res["status"])),
                                    res["mip_gap"], options.mip_gap if model.is_mip else 0.0)

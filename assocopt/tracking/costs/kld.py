@@ -96,6 +96,13 @@ def _quad(v: np.ndarray, M: np.ndarray) -> np.ndarray:
     return (v[..., None, :] @ M @ v[..., :, None])[..., 0, 0]
 
 
+def _gauss_pair(mu0: ArrayLike, S0: ArrayLike, mu1: ArrayLike, S1: ArrayLike) -> tuple:
+    """``(d, mu1 - mu0, (S0, S0^-1, ln det S0), (S1, S1^-1, ln det S1))`` of two stacked
+    d-dimensional Gaussians, as float arrays."""
+    mu0, S0, mu1, S1 = (np.asarray(a, dtype=np.float64) for a in (mu0, S0, mu1, S1))
+    return mu0.shape[-1], mu1 - mu0, (S0, *_inv_logdet(S0)), (S1, *_inv_logdet(S1))
+
+
 def kld_gauss(mu0: ArrayLike, S0: ArrayLike, mu1: ArrayLike, S1: ArrayLike) -> np.ndarray:
     """Exact ``KL(N(mu0, S0) || N(mu1, S1))`` for stacked d-dimensional Gaussians.
 
@@ -105,11 +112,7 @@ def kld_gauss(mu0: ArrayLike, S0: ArrayLike, mu1: ArrayLike, S1: ArrayLike) -> n
     >>> float(kld_gauss([0.0, 0.0], np.eye(2), [0.0, 0.0], np.eye(2)))
     0.0
     """
-    mu0, S0, mu1, S1 = (np.asarray(a, dtype=np.float64) for a in (mu0, S0, mu1, S1))
-    d = mu0.shape[-1]
-    _, logdet0 = _inv_logdet(S0)
-    S1inv, logdet1 = _inv_logdet(S1)
-    diff = mu1 - mu0
+    d, diff, (S0, S0inv, logdet0), (S1, S1inv, logdet1) = _gauss_pair(mu0, S0, mu1, S1)
     tr = _trace_prod(S1inv, S0)
     maha = _quad(diff, S1inv)
     return 0.5 * (tr + maha - d + logdet1 - logdet0)
@@ -123,11 +126,7 @@ def skld_gauss(mu0: ArrayLike, S0: ArrayLike, mu1: ArrayLike, S1: ArrayLike) -> 
     >>> round(float(skld_gauss([1.0], [[1.0]], [0.0], [[4.0]])), 6)
     1.75
     """
-    mu0, S0, mu1, S1 = (np.asarray(a, dtype=np.float64) for a in (mu0, S0, mu1, S1))
-    d = mu0.shape[-1]
-    S0inv, _ = _inv_logdet(S0)
-    S1inv, _ = _inv_logdet(S1)
-    diff = mu1 - mu0
+    d, diff, (S0, S0inv, _), (S1, S1inv, _) = _gauss_pair(mu0, S0, mu1, S1)
     tr = _trace_prod(S1inv, S0) + _trace_prod(S0inv, S1)
     maha = _quad(diff, S0inv + S1inv)
     return 0.5 * (tr - 2.0 * d + maha)

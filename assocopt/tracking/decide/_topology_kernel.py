@@ -183,6 +183,15 @@ def _pair_assignment(X1r, P1r, X2r, P2r, J1, var1, J2, var2, u, v, inflate, eucl
 
 
 @njit(cache=True)
+def _workspace(n1, n2):
+    """The scratch arrays of :func:`_pair_assignment` for ``n1`` x ``n2`` tracks:
+    ``(G, A, rows, cols, col)``, ``A`` square of side ``max(n1, n2)``, zeroed."""
+    n = max(n1, n2)
+    return (np.empty((n1, n2)), np.zeros((n, n)), np.empty(n1, np.int64),
+            np.empty(n2, np.int64), np.empty(n1, np.int64))
+
+
+@njit(cache=True)
 def assign_kernel(X1r, P1r, X2r, P2r, J1, var1, J2, var2, inflate, euclid, thr, dummy,
                   active):
     """Every reference pair's assignment: ``(cols, gam)`` with ``cols[u, v, i]`` the
@@ -191,14 +200,9 @@ def assign_kernel(X1r, P1r, X2r, P2r, J1, var1, J2, var2, inflate, euclid, thr, 
     ``gam[u, v, i]`` its distance (``inf`` where ``cols`` is ``-1``)."""
     n1 = X1r.shape[1]
     n2 = X2r.shape[1]
-    n = max(n1, n2)
     out = np.full((n1, n2, n1), -1, np.int64)
     gam = np.full((n1, n2, n1), INF)
-    G = np.empty((n1, n2))
-    A = np.zeros((n, n))
-    rows = np.empty(n1, np.int64)
-    cols = np.empty(n2, np.int64)
-    col = np.empty(n1, np.int64)
+    G, A, rows, cols, col = _workspace(n1, n2)
     for u in range(n1):
         for v in range(n2):
             if not active[u, v]:
@@ -230,14 +234,9 @@ def phi_kernel(X1r, P1r, X2r, P2r, J1, var1, J2, var2, inflate, euclid, thr, dum
     """
     n1 = X1r.shape[1]
     n2 = X2r.shape[1]
-    n = max(n1, n2)
     phi = np.full((n1, n2), large)
     M = np.zeros((n1, n2), np.int64)
-    G = np.empty((n1, n2))
-    A = np.zeros((n, n))
-    rows = np.empty(n1, np.int64)
-    cols = np.empty(n2, np.int64)
-    col = np.empty(n1, np.int64)
+    G, A, rows, cols, col = _workspace(n1, n2)
     for u in range(n1):
         for v in range(n2):
             if not active[u, v]:
