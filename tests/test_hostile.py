@@ -8,6 +8,7 @@ recognised by its status, an interrupt by its exit code.
 
 from __future__ import annotations
 
+import functools
 import json
 import math
 import os
@@ -716,9 +717,14 @@ class TestRankingEdgeInputs:
                              "--kbest", "2", "--solver", "murty2d")
         assert code == 2 and len(err.strip().splitlines()) == 1 and "2-D" in err
 
-    def test_marginals_enumerate_too_large_points_to_kbest(self):
+    def test_marginals_enumerate_too_large_points_to_kbest(self, monkeypatch):
+        """The node cap lowered to 20000 (the default 2 million costs 15 s of search
+        to reach; the error path is the same)."""
         from assocopt import marginals
+        from assocopt.solvers import bruteforce
 
+        capped = functools.partial(bruteforce.enumerate_solutions, max_nodes=20_000)
+        monkeypatch.setattr(bruteforce, "enumerate_solutions", capped)
         p = AssignmentProblem.dense(np.random.default_rng(0).random((30, 30)))
         with pytest.raises(ProblemTooLargeError, match="use method='kbest'"):
             marginals(p, method="enumerate")
