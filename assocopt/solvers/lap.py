@@ -167,8 +167,17 @@ def assign_with_misses(n1: int, n2: int, rows: np.ndarray, cols: np.ndarray,
         row_of_col[c] = r
         return Assignment2D(col_of_row, row_of_col, how)
     size = n1 + n2
+    n_aug = 2 * len(rows) + int(fin_r.sum()) + int(fin_c.sum())   # augmented edges
+    sparse = method == "sparse" or (method == "auto" and _prefer_sparse(size, n_aug))
+    if sparse and _compiled_sparse():
+        # the compiled engine on the smallest exact form (no scipy matrix per call)
+        from .sparse2d import assign_sparse
+        col_of_row, _ = assign_sparse(n1, n2, rows, cols, weights, row_miss, col_miss)
+        on = col_of_row >= 0
+        row_of_col[col_of_row[on]] = np.flatnonzero(on)
+        return Assignment2D(col_of_row, row_of_col, "sparse")
     ar, ac, aw = augmented_edges(n1, n2, rows, cols, weights, row_miss, col_miss)
-    if method == "sparse" or (method == "auto" and _prefer_sparse(size, len(ar))):
+    if sparse:
         r, c = _sparse_lap(size, size, ar, ac, aw)
         how = "sparse"
     else:
@@ -186,6 +195,12 @@ def assign_with_misses(n1: int, n2: int, rows: np.ndarray, cols: np.ndarray,
     col_of_row[r[real]] = c[real]
     row_of_col[c[real]] = r[real]
     return Assignment2D(col_of_row, row_of_col, how)
+
+
+def _compiled_sparse() -> bool:
+    """Whether the compiled sparse LAP (:mod:`assocopt.solvers.sparse2d`) can run."""
+    from .base import module_installed
+    return module_installed("numba")
 
 
 def _prefer_sparse(size: int, n_edges: int) -> bool:
