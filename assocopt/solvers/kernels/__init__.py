@@ -1,10 +1,12 @@
-"""numba kernels of the ``bnb`` back end, the compiled window search of
-``lagrangian-exact``, the sparse 2-D LAP (:mod:`.sparse_lap`, imported by
-:mod:`assocopt.solvers.sparse2d`) and the 2-D ranking of :func:`assocopt.kbest`
-(:mod:`.sap`: a warm-startable shortest-augmenting-path LAP on dense matrices,
-:mod:`.murty2d`: Murty's method on it, imported by :mod:`assocopt.ranking.kbest2d`); imported
-only when one of them runs (importing numba costs half a second).
-:mod:`assocopt.solvers.bnb_kernels` is the import point of the ``bnb`` kernels.
+"""numba kernels of the ``bnb`` back end (its N = 3 recovery on gated problems:
+:mod:`.recovery`), the compiled window search of ``lagrangian-exact``, the dominance
+rule of both Lagrangian back ends (:mod:`.dominance`), the sparse 2-D LAP
+(:mod:`.sparse_lap`, imported by :mod:`assocopt.solvers.sparse2d`) and the 2-D ranking
+of :func:`assocopt.kbest` (:mod:`.sap`: a warm-startable shortest-augmenting-path LAP
+on dense matrices, :mod:`.murty2d`: Murty's method on it, imported by
+:mod:`assocopt.ranking.kbest2d`); imported only when one of them runs (importing numba
+costs half a second). :mod:`assocopt.solvers.bnb_kernels` is the import point of the
+``bnb`` kernels.
 
 numba's disk cache does not notice a change in a kernel another file calls: after
 editing ``sap.py``, delete ``__pycache__/murty2d.*.nb[ic]`` (the same holds for
