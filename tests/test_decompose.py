@@ -77,12 +77,18 @@ def _agree(a, b):
         assert abs(a.bound - a.objective) <= 1e-9 * max(1.0, abs(a.objective))
 
 
+def _reference(p):
+    """The whole problem by brute force (HiGHS past brute force's node cap)."""
+    whole = solve(p, "bruteforce", decompose=False)
+    if whole.status is Status.TIME_LIMIT:
+        whole = solve(p, "highs", decompose=False)
+    return whole
+
+
 @settings(max_examples=60)
 @given(side_by_side())
 def test_decomposed_equals_whole(p):
-    whole = solve(p, "bruteforce", decompose=False)
-    if whole.status is Status.TIME_LIMIT:     # past its node cap: HiGHS on the whole
-        whole = solve(p, "highs", decompose=False)
+    whole = _reference(p)
     for solver in ("highs", "auto", "bruteforce", "lagrangian-exact"):
         sol = solve(p, solver, decompose=True)
         _agree(sol, whole)
@@ -213,9 +219,38 @@ def test_batch_budget_spent_components_are_solved_again(p):
     """bnb's batch with a node budget of 1: the components it cannot prove go to
     bnb alone (and its fallback), and the whole is still exact."""
     pytest.importorskip("numba")
-    whole = solve(p, "bruteforce", decompose=False)
+    whole = _reference(p)
     sol = solve(p, "bnb", decompose=True, max_nodes=1, max_iter=1, probe_every=0,
                 recover_every=0)
     _agree(sol, whole)
     if sol.status is Status.OPTIMAL:
         assert_optimal(p, sol)
+
+
+@settings(max_examples=20)
+@given(side_by_side(feasible=True))
+def test_auto_sends_large_gated_components_to_lagrangian_exact(p):
+    """With ``BNB_MAX_GATED`` lowered, components with dummies above it go to
+    ``lagrangian-exact`` (the others stay in the batch), and the whole is exact."""
+    pytest.importorskip("numba")
+    import assocopt.solving.choice as choice
+    sp = split(p)
+    todo = np.flatnonzero(~sp.trivial)
+    if not len(todo):
+        return
+    cap = int(np.median(sp.sizes[todo]))
+    mp = pytest.MonkeyPatch()
+    with mp.context() as m:
+        m.setattr(choice, "BNB_MAX_GATED", cap)
+        sol = solve(p, "auto", decompose=True)
+    whole = _reference(p)
+    _agree(sol, whole)
+    if sol.status is not Status.OPTIMAL:
+        return
+    assert_optimal(p, sol)
+    if sp.n == 1:
+        return
+    used = sol.info["decomposition"]["solvers"]
+    big = int((sp.sizes[todo] > cap).sum())        # every block here has dummies
+    assert used.get("lagrangian-exact", 0) == big
+    assert used.get("bnb", 0) == len(todo) - big

@@ -3,7 +3,8 @@
 This module owns the 2-D LAP: the engines and the augmentations that turn miss costs
 into a plain LAP; everything else on the 2-D path (:mod:`.sparse2d`, :mod:`.dense2d`,
 the ``scipy-lsa`` and ``lapjv`` back ends, the Lagrangian S-D solver
-:mod:`assocopt.solvers.lagrangian`) builds on it and it imports none of them.
+:mod:`assocopt.solvers.lagrangian`) builds on it and it imports none of them at module
+level or inside (the compiled sparse LAP comes from :mod:`.kernels.sparse_lap`).
 
 * :func:`linear_assignment` -- a dense (possibly rectangular) LAP, ``inf`` = forbidden,
   scipy's semantics (the smaller side fully assigned).  It runs lapx's Jonker-Volgenant
@@ -11,9 +12,11 @@ the ``scipy-lsa`` and ``lapjv`` back ends, the Lagrangian S-D solver
   enough for it to pay off, else :func:`scipy.optimize.linear_sum_assignment`.
 * :func:`assign_with_misses` -- 2-D assignment with per-row and per-column
   non-assignment ("miss") costs, from a sparse edge list; it picks a dense matrix or,
-  for large gated problems, scipy's sparse LAPJVsp
+  for large gated problems (or ``method="sparse"``), the compiled sparse LAP of
+  :mod:`.kernels.sparse_lap` (numba installed: no scipy matrix built per call, which
+  the Lagrangian ascent makes hundreds of times), else scipy's sparse LAPJVsp
   (:func:`scipy.sparse.csgraph.min_weight_full_bipartite_matching`) on the standard
-  augmentation whose dummy-dummy block is the transpose of the edge pattern, so memory
+  augmentation whose dummy-dummy block is the transpose of the edge pattern; memory
   grows with the number of edges, not with ``n1 * n2``.
 * :func:`augmented_matrix` / :func:`augmented_edges` -- the ``(n1+n2)``-square
   augmentation of 2-D assignment with miss costs, dense or as an edge list.
@@ -167,9 +170,12 @@ def assign_with_misses(n1: int, n2: int, rows: np.ndarray, cols: np.ndarray,
         row_of_col[c] = r
         return Assignment2D(col_of_row, row_of_col, how)
     size = n1 + n2
+    n_aug = 2 * len(rows) + int(fin_r.sum()) + int(fin_c.sum())   # augmented edges
+    sparse = method == "sparse" or (method == "auto" and _prefer_sparse(size, n_aug))
     ar, ac, aw = augmented_edges(n1, n2, rows, cols, weights, row_miss, col_miss)
-    if method == "sparse" or (method == "auto" and _prefer_sparse(size, len(ar))):
-        r, c = _sparse_lap(size, size, ar, ac, aw)
+    if sparse:
+        r, c = _compiled_lap(size, ar, ac, aw) if _compiled_sparse() else \
+            _sparse_lap(size, size, ar, ac, aw)
         how = "sparse"
     else:
         M = np.full((size, size), np.inf)
@@ -186,6 +192,26 @@ def assign_with_misses(n1: int, n2: int, rows: np.ndarray, cols: np.ndarray,
     col_of_row[r[real]] = c[real]
     row_of_col[c[real]] = r[real]
     return Assignment2D(col_of_row, row_of_col, how)
+
+
+def _compiled_sparse() -> bool:
+    """Whether the compiled sparse LAP (:mod:`.kernels.sparse_lap`) can run."""
+    from .base import module_installed
+    return module_installed("numba")
+
+
+def _compiled_lap(size: int, rows, cols, weights) -> tuple[np.ndarray, np.ndarray]:
+    """A perfect matching of the square edge list by the compiled sparse LAP (no scipy
+    matrix built per call, which the Lagrangian ascent makes hundreds of times)."""
+    from .kernels import ensure
+    from .kernels.sparse_lap import lap_edges
+    args = (size, size, np.ascontiguousarray(rows, np.int64),
+            np.ascontiguousarray(cols, np.int64), np.ascontiguousarray(weights, np.float64))
+    ensure(lap_edges, *args)
+    edge, bad = lap_edges(*args)
+    if bad >= 0:
+        raise LapInfeasibleError("no perfect matching of the augmented edges")
+    return np.arange(size), args[3][edge]
 
 
 def _prefer_sparse(size: int, n_edges: int) -> bool:

@@ -8,7 +8,7 @@ from __future__ import annotations
 from ..problems.problem import AssignmentProblem
 from ..solvers.base import module_installed
 
-__all__ = ["choose_solver", "BNB_MAX_CANDIDATES", "BNB_MAX_KEPT"]
+__all__ = ["choose_solver", "BNB_MAX_CANDIDATES", "BNB_MAX_GATED", "BNB_MAX_KEPT"]
 
 
 #: ``auto`` sends N >= 3 problems with at most this many candidates to ``bnb``
@@ -20,19 +20,27 @@ BNB_MAX_CANDIDATES = 10_000
 #: Hungarian costs O((n_a + n_b)^3) per iteration, ``lagrangian-exact``'s sparse LAP
 #: far less on large sparse problems.
 BNB_MAX_KEPT = 100
+#: ... and, for problems with dummies (gated tracking scans and their components), at
+#: most this many candidates: above it ``lagrangian-exact`` (dominance rule, sparse
+#: LAP, fixing probes) beat ``bnb`` on the 300-12,000-candidate components of the
+#: N = 3-6 scans of benchmarks/sd_tracking.py (seeds 51-53, not the page's): from
+#: about 2,500 candidates by 1.2-12x (5,823 candidates at N = 5: 0.29 s against
+#: 0.023 s), level around 1,500-2,000, ``bnb`` ahead below.
+BNB_MAX_GATED = 2_000
 
 
 def choose_solver(problem: AssignmentProblem, relax: str | None = None) -> str:
     """The back end ``solver="auto"`` picks, by size and structure (measured in
     docs/benchmarks-sd.md): the 2-D fast path; for S-D (N >= 3) the compiled branch
-    and bound ``bnb`` up to :data:`BNB_MAX_CANDIDATES` candidates and
-    :data:`BNB_MAX_KEPT` kept-axes indices (numba installed), else the Lagrangian exact
-    method; HiGHS for LP relaxations."""
+    and bound ``bnb`` up to :data:`BNB_MAX_CANDIDATES` candidates (:data:`BNB_MAX_GATED`
+    with dummies) and :data:`BNB_MAX_KEPT` kept-axes indices (numba installed), else
+    the Lagrangian exact method; HiGHS for LP relaxations."""
     if relax is not None:
         return "highs"
     if problem.ndim == 2:
         return "scipy-lsa"
-    if problem.n_candidates <= BNB_MAX_CANDIDATES and _bnb_usable(problem):
+    if problem.n_candidates <= BNB_MAX_CANDIDATES and _bnb_usable(problem) and \
+            (problem.n_candidates <= BNB_MAX_GATED or not (problem.tuples == 0).any()):
         return "bnb"
     return "lagrangian-exact"
 

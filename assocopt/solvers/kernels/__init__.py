@@ -1,10 +1,12 @@
-"""numba kernels of the ``bnb`` back end, the compiled window search of
-``lagrangian-exact``, the sparse 2-D LAP (:mod:`.sparse_lap`, imported by
-:mod:`assocopt.solvers.sparse2d`) and the 2-D ranking of :func:`assocopt.kbest`
-(:mod:`.sap`: a warm-startable shortest-augmenting-path LAP on dense matrices,
-:mod:`.murty2d`: Murty's method on it, imported by :mod:`assocopt.ranking.kbest2d`); imported
-only when one of them runs (importing numba costs half a second).
-:mod:`assocopt.solvers.bnb_kernels` is the import point of the ``bnb`` kernels.
+"""numba kernels of the ``bnb`` back end (its N = 3 recovery on gated problems:
+:mod:`.recovery`), the compiled window search of ``lagrangian-exact``, the dominance
+rule of both Lagrangian back ends (:mod:`.dominance`), the sparse 2-D LAP
+(:mod:`.sparse_lap`, imported by :mod:`assocopt.solvers.sparse2d`) and the 2-D ranking
+of :func:`assocopt.kbest` (:mod:`.sap`: a warm-startable shortest-augmenting-path LAP
+on dense matrices, :mod:`.murty2d`: Murty's method on it, imported by
+:mod:`assocopt.ranking.kbest2d`); imported only when one of them runs (importing numba
+costs half a second). :mod:`assocopt.solvers.bnb_kernels` is the import point of the
+``bnb`` kernels.
 
 numba's disk cache does not notice a change in a kernel another file calls: after
 editing ``sap.py``, delete ``__pycache__/murty2d.*.nb[ic]`` (the same holds for
@@ -37,16 +39,42 @@ def spent() -> tuple[float, float]:
 def ensure(kernel: Any, *args: Any) -> None:
     """Make sure ``kernel`` has machine code for the types of ``args`` (only that
     specialisation, and the kernels it calls), timing the compilation or the load
-    from the disk cache apart from the call itself."""
+    from the disk cache apart from the call itself.
+
+    Hot loops call this before every kernel call (the Lagrangian ascent: once per
+    2-D solve), where numba's own typing of the arguments cost more than a small
+    LAP (0.37 ms against 0.17 ms per call on a gated scan): a signature seen before,
+    keyed cheaply by argument kind, dtype, rank and layout, returns at once.  A key
+    that misses a distinction numba makes only moves a compilation into the call's
+    own time, never changes a result."""
+    key = (id(kernel),) + tuple(_kind(a) for a in args)
+    if key in _SEEN:
+        return
     try:
         sig = tuple(kernel.typeof_pyval(a) for a in args)
     except Exception:          # not a numba dispatcher: nothing to prepare
         return
     if sig in kernel.overloads:
+        _SEEN.add(key)
         return
     hits = sum(kernel.stats.cache_hits.values())
     t0 = time.perf_counter()
     kernel.compile(sig)
     dt = time.perf_counter() - t0
     _SPENT["cache_load" if sum(kernel.stats.cache_hits.values()) > hits else "compile"] += dt
+    _SEEN.add(key)
+
+
+#: Cheap keys of the signatures :func:`ensure` has seen compiled.
+_SEEN: set = set()
+
+
+def _kind(a: Any) -> Any:
+    """What numba's dispatch depends on, cheaply: arrays by dtype, rank, layout and
+    writability, scalars by Python type."""
+    flags = getattr(a, "flags", None)
+    if flags is None or not hasattr(a, "dtype"):
+        return type(a)
+    return (a.dtype.str, a.ndim, flags.c_contiguous, flags.f_contiguous, flags.writeable,
+            flags.aligned)
 

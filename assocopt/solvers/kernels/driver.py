@@ -7,6 +7,7 @@ import numpy as np
 from numba import njit
 
 from .hungarian import hungarian
+from .recovery import recover3_sparse
 from .relaxation import (evaluate, full_reduced, improve_limit, raise_rows, reduced,
                          sort_lists)
 from .search import COMPLETE, dfs
@@ -24,11 +25,13 @@ def tuple_index(G, pa, pb, pc, na, nb, nc):
 
 
 @njit(cache=True)
-def recover3(c, pa, pb, chosen, idx, nb, nc, sel):
+def recover3(c, pa, pb, chosen, idx, nb, nc, sel, sparse=True):
     """Primal recovery for N = 3 (Pattipati et al.): keep the relaxed solution's
     kept-axes pairs, attach the third axis by a 2-D assignment with misses (pair
     alone, or the index alone).  Fills ``sel``; returns ``(n, cost)``, ``n = -1`` if
-    that assignment is infeasible."""
+    that assignment is infeasible.  ``sparse``: when every third-axis index has its
+    single-index candidate, solve it as a sparse LAP (:mod:`.recovery`; the same
+    optimum) instead of the dense Hungarian."""
     W = nc + 1
     npair = 0
     base_of = np.empty(chosen.shape[0], np.int64)
@@ -48,6 +51,14 @@ def recover3(c, pa, pb, chosen, idx, nb, nc, sel):
                 break
     if plain and npair != nc:
         return -1, INF
+    if not plain:
+        gated = True                      # every index has its single: sparse LAP
+        for t in range(1, nc + 1):
+            if idx[t] < 0:
+                gated = False
+                break
+        if gated and sparse:
+            return recover3_sparse(c, base_of, npair, idx, nc, sel)
     S = nc if plain else npair + nc
     A = np.full((S, S), INF)
     for g in range(npair):

@@ -2,7 +2,10 @@
 
 A multi-index candidate is dropped when splitting it into two candidates (or into
 single-index ones) covers the same indices at no higher cost; the optimum is kept.
-Applied by both back ends before the ascent (option ``reduce``).
+Applied by both back ends before the ascent (option ``reduce``).  With numba
+installed the rule runs compiled (:mod:`assocopt.solvers.kernels.dominance`, one pass
+with a hash table: on a gated N = 5 tracking scan's 12,000-candidate component 63 ms
+in numpy became a few ms); the numpy version below is the reference and the fallback.
 """
 
 from __future__ import annotations
@@ -12,7 +15,8 @@ import math
 import numpy as np
 
 
-def dominated(sizes: tuple[int, ...], T: np.ndarray, c: np.ndarray) -> np.ndarray:
+def dominated(sizes: tuple[int, ...], T: np.ndarray, c: np.ndarray,
+              compiled: bool | None = None) -> np.ndarray:
     """Mask of candidates that a split into cheaper-or-equal candidates dominates.
 
     A candidate with two or more real indices is dropped when its cost is at least
@@ -21,6 +25,8 @@ def dominated(sizes: tuple[int, ...], T: np.ndarray, c: np.ndarray) -> np.ndarra
     else as single-index candidates).  Replacing a dropped candidate by its split
     keeps a solution feasible at no extra cost, and splits have strictly fewer real
     indices (single-index candidates are never dropped), so the optimum is kept.
+    ``compiled``: use the numba kernel (None: when numba is installed); both give
+    the same mask.
 
     Examples
     --------
@@ -34,6 +40,11 @@ def dominated(sizes: tuple[int, ...], T: np.ndarray, c: np.ndarray) -> np.ndarra
     multi = nreal >= 2
     if K == 0 or not multi.any() or nreal.min() == nreal.max():
         return np.zeros(K, bool)
+    if compiled is None:
+        from ..base import module_installed
+        compiled = module_installed("numba")
+    if compiled:
+        return _dominated_compiled(sizes, T, c, nreal)
     single = np.flatnonzero(nreal == 1)
     S = [np.full(n + 1, np.inf) for n in sizes]
     s_axis = real[single].argmax(axis=1)
@@ -49,9 +60,8 @@ def dominated(sizes: tuple[int, ...], T: np.ndarray, c: np.ndarray) -> np.ndarra
         return tot
 
     best = np.where(multi, singles(T), np.inf)
-    radix = np.cumprod([1] + [n + 1 for n in sizes[::-1]])[:-1][::-1]
-    if math.prod(n + 1 for n in sizes) < 2 ** 62:
-        radix = radix.astype(np.int64)
+    radix, fits = _radix(sizes)
+    if fits:
         key = T @ radix
         order = np.argsort(key)
         skey, scost = key[order], c[order]
@@ -75,3 +85,29 @@ def dominated(sizes: tuple[int, ...], T: np.ndarray, c: np.ndarray) -> np.ndarra
             rows = pick[ok]
             best[rows] = np.minimum(best[rows], val)
     return multi & (c >= best)
+
+
+def _radix(sizes: tuple[int, ...]) -> tuple[np.ndarray, bool]:
+    """Mixed-radix weights of a tuple's key (``T @ radix``), and whether the keys
+    fit in int64."""
+    radix = np.cumprod([1] + [n + 1 for n in sizes[::-1]])[:-1][::-1]
+    fits = math.prod(n + 1 for n in sizes) < 2 ** 62
+    return (radix.astype(np.int64) if fits else np.zeros(len(sizes), np.int64)), fits
+
+
+def _dominated_compiled(sizes: tuple[int, ...], T: np.ndarray, c: np.ndarray,
+                        nreal: np.ndarray) -> np.ndarray:
+    """:func:`dominated` by the compiled kernel (same mask)."""
+    from ..kernels import ensure
+    from ..kernels.dominance import dominated_kernel
+    N = T.shape[1]
+    off = np.concatenate([[0], np.cumsum(sizes)[:-1]]).astype(np.int64)
+    single_cost = np.full(int(sum(sizes)), np.inf)
+    one = np.flatnonzero(nreal == 1)
+    axis = (T[one] > 0).argmax(axis=1)
+    single_cost[off[axis] + T[one, axis] - 1] = c[one]
+    radix, fits = _radix(sizes)
+    args = (np.ascontiguousarray(T, np.int64), np.ascontiguousarray(c, np.float64), off,
+            radix, single_cost, fits)
+    ensure(dominated_kernel, *args)
+    return dominated_kernel(*args)

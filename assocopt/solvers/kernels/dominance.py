@@ -1,0 +1,118 @@
+"""The dominance rule of :func:`assocopt.solvers.lagrangian.reduction.dominated`, compiled.
+
+Same rule, same answer; one pass over the candidates instead of ``2^(N-1) - 1``
+numpy passes (one per split of the axes) with a sorted-key lookup each.  Tuples are
+keyed by their mixed-radix number and looked up in an open-addressing hash table
+(Fibonacci hashing), so a split costs two probes.  Measured on the largest component
+of a gated N = 5 tracking scan (12,326 candidates): 63 ms in numpy, a few ms here.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from numba import njit
+
+__all__ = ["dominated_kernel"]
+
+_GOLD = np.uint64(0x9E3779B97F4A7C15)
+
+
+@njit(cache=True, nogil=True)
+def _table(keys, c):
+    """Hash table of the tuple keys: ``(slot_key, slot_cost, shift)``; a slot's cost
+    is the least of the candidates with that key (-1: empty slot)."""
+    K = keys.shape[0]
+    bits = 1
+    while (1 << bits) < 2 * K + 2:
+        bits += 1
+    size = 1 << bits
+    skey = np.full(size, -1, np.int64)
+    scost = np.full(size, np.inf)
+    shift = np.uint64(64 - bits)
+    mask = size - 1
+    for k in range(K):
+        h = np.int64((np.uint64(keys[k]) * _GOLD) >> shift)
+        while skey[h] != -1 and skey[h] != keys[k]:
+            h = (h + 1) & mask
+        skey[h] = keys[k]
+        if c[k] < scost[h]:
+            scost[h] = c[k]
+    return skey, scost, shift
+
+
+@njit(cache=True, nogil=True)
+def _lookup(skey, scost, shift, key):
+    mask = skey.shape[0] - 1
+    h = np.int64((np.uint64(key) * _GOLD) >> shift)
+    while skey[h] != -1:
+        if skey[h] == key:
+            return scost[h]
+        h = (h + 1) & mask
+    return np.inf
+
+
+@njit(cache=True, nogil=True)
+def dominated_kernel(T, c, off, radix, single_cost, use_keys):
+    """Mask of the dominated candidates (see ``dominated``).
+
+    ``T`` (K, N) tuples (0 = dummy), ``c`` their costs; ``single_cost`` the cost of
+    the single-index candidate of each real index (rows ``off[s] + i - 1``; ``inf``
+    when there is none); ``radix`` (N,) the mixed-radix weights of a tuple's key;
+    ``use_keys`` False: only the split into single-index candidates (the keys would
+    overflow).
+    """
+    K, N = T.shape
+    out = np.zeros(K, np.bool_)
+    if use_keys:
+        keys = np.zeros(K, np.int64)
+        for k in range(K):
+            v = 0
+            for s in range(N):
+                v += T[k, s] * radix[s]
+            keys[k] = v
+        skey, scost, shift = _table(keys, c)
+    else:
+        skey = np.full(2, -1, np.int64)
+        scost = np.full(2, np.inf)
+        shift = np.uint64(63)
+    part = np.empty(N)                      # single-index cost of each axis' index
+    for k in range(K):
+        m = 0
+        tot = 0.0
+        for s in range(N):
+            if T[k, s] > 0:
+                m += 1
+                part[s] = single_cost[off[s] + T[k, s] - 1]
+            else:
+                part[s] = 0.0
+            tot += part[s]
+        if m < 2:
+            continue
+        best = tot
+        if use_keys:
+            for mask in range(1, (1 << N) - 1, 2):      # splits: A holds axis 0
+                ka = 0
+                kb = 0
+                ra = 0
+                rb = 0
+                sa = 0.0
+                sb = 0.0
+                for s in range(N):
+                    if T[k, s] > 0:
+                        if (mask >> s) & 1:
+                            ka += T[k, s] * radix[s]
+                            ra += 1
+                            sa += part[s]
+                        else:
+                            kb += T[k, s] * radix[s]
+                            rb += 1
+                            sb += part[s]
+                if ra == 0 or rb == 0:
+                    continue
+                # one real index: its own candidate is the single-index one
+                va = sa if ra == 1 else min(_lookup(skey, scost, shift, ka), sa)
+                vb = sb if rb == 1 else min(_lookup(skey, scost, shift, kb), sb)
+                if va + vb < best:
+                    best = va + vb
+        out[k] = c[k] >= best
+    return out
