@@ -227,7 +227,8 @@ class AssocoptMFA(DataAssociator):
     is the window's :class:`~assocopt.Solution` (objective = the chosen hypotheses'
     summed ``-log(weight)``, bound, gap, status, times), ``last_costs`` the costs of
     the global hypotheses kept (best first) and ``last_window`` the
-    :class:`~assocopt.tracking.mfa.WindowProblem`.
+    :class:`~assocopt.tracking.mfa.WindowProblem` (with ``k = 1``, dominated
+    hypotheses left out: ``drop_dominated``).
     """
 
     hypothesiser: Hypothesiser = Property(
@@ -237,6 +238,11 @@ class AssocoptMFA(DataAssociator):
     solver_options: dict = Property(
         default=None, doc="Keyword options passed to :func:`assocopt.solve` / ``kbest``")
     k: int = Property(default=1, doc="Global hypotheses whose histories pruning keeps")
+    drop_dominated: bool = Property(
+        default=True,
+        doc="With ``k = 1``, leave out of the window problem the hypotheses that a "
+            "cheaper one of their track with fewer detections dominates (same optimum, "
+            "smaller problem; :func:`assocopt.tracking.mfa.dominated`)")
 
     def __init__(self, *args, **kwargs):
         super().__init__(*args, **kwargs)
@@ -272,7 +278,8 @@ class AssocoptMFA(DataAssociator):
         preds = [h.prediction for h in flat]
         cost = np.array([log_cost(p.weight) for p in preds], np.float64)
         history, labels = tag_arrays([p.tag for p in preds], self.slide_window)
-        wp = window_problem(track_id, cost, history, n_tracks=len(order))
+        wp = window_problem(track_id, cost, history, n_tracks=len(order),
+                            drop_dominated=bool(self.drop_dominated) and self.k == 1)
         opts = self.solver_options or {}
         if self.k == 1:
             sol, choice = solve_window(wp, self.solver, **opts)
