@@ -32,7 +32,6 @@ from __future__ import annotations
 import argparse
 import json
 import os
-import platform
 import statistics
 import sys
 import time
@@ -43,6 +42,9 @@ import numpy as np
 
 ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))
+sys.path.insert(0, str(ROOT / "benchmarks"))
+
+from stonesoup_assoc import command, machine, write_pages  # noqa: E402
 
 CONFIGS = "5x2,5x3,5x4,5x5,5x6,10x2,10x3,10x4,10x5,20x3,20x4,50x3,50x4"
 GATE = 4.0
@@ -58,21 +60,6 @@ def _best_of(call, repeat: int):
         wall = min(wall, time.perf_counter() - t0)
         cpu = min(cpu, time.process_time() - c0)
     return out, wall, cpu
-
-
-def their_cost(hypotheses: dict, window: int) -> float:
-    """Cost of the global hypothesis Stone Soup's MFA algorithm selects."""
-    from stonesoup.dataassociator.mfa import _init, _step
-    hyps = [_init.Hyp.create(trackID=i, cost=-np.log(h.prediction.weight),
-                             measHistory=h.prediction.tag, slide_window=window)
-            for i, mh in enumerate(hypotheses.values()) for h in mh]
-    info = _init.init_hyp_info(hyps, window)
-    state = _step.AlgorithmState.initialise(window, len(info.hyps))
-    for _ in range(_step.MAX_ITERATION_COUNT):
-        _step.algorithm_step(state, info)
-        if state.should_break:
-            break
-    return float(info.all_costs[state.get_best_hypothesis_indices()].sum())
 
 
 def _tags(assoc: dict) -> dict:
@@ -103,16 +90,12 @@ def run_config(n: int, window: int, steps: int, seed: int, repeat: int,
     from stonesoup.models.transition.linear import (CombinedLinearGaussianTransitionModel,
                                                     ConstantVelocity)
     from stonesoup.predictor.kalman import KalmanPredictor
-    from stonesoup.types.detection import Clutter, Detection
-    from stonesoup.types.mixture import GaussianMixture
-    from stonesoup.types.numeric import Probability
-    from stonesoup.types.state import TaggedWeightedGaussianState
-    from stonesoup.types.track import Track
     from stonesoup.types.update import GaussianMixtureUpdate
     from stonesoup.updater.kalman import KalmanUpdater
 
     from assocopt.tracking.simulate import CrossingScenario
-    from assocopt.tracking.stonesoup import AssocoptMFA
+    from assocopt.tracking.stonesoup import AssocoptMFA, mfa_reference_cost
+    from assocopt.tracking.stonesoup_scenario import mixture_tracks, scan_detections
     from assocopt.tracking.stonesoup_hypothesiser import LinearGaussianMFAHypothesiser
 
     class Cached(Hypothesiser):
@@ -137,15 +120,11 @@ def run_config(n: int, window: int, steps: int, seed: int, repeat: int,
     ours, ref = AssocoptMFA(cached, slide_window=window), \
         MFADataAssociator(cached, slide_window=window)
     start = datetime(2026, 1, 1)
-    tracks = [Track([GaussianMixture([TaggedWeightedGaussianState(
-        x[:, None], np.diag([1.0, 0.5, 1.0, 0.5]), timestamp=start, weight=Probability(1),
-        tag=[])])]) for x in out.truth[0]]
+    tracks = mixture_tracks(out.truth[0], start)
     rows = []
     for k, (zs, lab) in enumerate(zip(out.meas, out.labels), start=1):
         t = start + timedelta(seconds=k * sc.dt)
-        dets = {(Clutter if lab[m] < 0 else Detection)(zs[m][:, None], timestamp=t,
-                                                        measurement_model=mm)
-                for m in range(len(zs))}
+        dets = scan_detections(zs, lab, t, mm)
         dtup = tuple(dets)
         t0 = time.perf_counter()
         table = {tr: fast.hypothesise(tr, dets, t, dtup) for tr in tracks}
@@ -171,7 +150,7 @@ def run_config(n: int, window: int, steps: int, seed: int, repeat: int,
                    axes=int(wp.problem.ndim), solver=sol.solver,
                    solve_s=float(min(solve_times)), status=sol.status.value,
                    ours_cost=float(sol.objective), bound=float(sol.bound),
-                   gap=float(sol.gap), stonesoup_cost=their_cost(table, window))
+                   gap=float(sol.gap), stonesoup_cost=mfa_reference_cost(table, window))
         row["theirs_optimal"] = abs(row["stonesoup_cost"] - row["ours_cost"]) <= 1e-9 * max(
             1.0, abs(row["ours_cost"]))
         row["same_pruned"] = _tags(a) == _tags(b) if row["theirs_optimal"] else None
@@ -320,20 +299,11 @@ def main(argv=None) -> dict:
         n, w = (int(v) for v in c.split("x"))
         configs.append(run_config(n, w, args.steps, args.seed, args.repeat, c in gen))
         print(f"{c}: {summary(configs[-1])}", flush=True)
-    given = list(argv if argv is not None else sys.argv[1:])
-    extra = [a for i, a in enumerate(given) if not a.startswith("--out")
-             and not (i and given[i - 1] == "--out")]
-    result = {"command": " ".join(["python benchmarks/mfa.py"] + extra), "configs": configs,
+    result = {"command": command("python benchmarks/mfa.py", argv), "configs": configs,
               "repeat": args.repeat, "steps": args.steps, "seed": args.seed,
-              "machine": {"cpu_count": os.cpu_count(), "platform": platform.platform(),
-                          "load_start": load_start,
-                          "load_end": [round(v, 2) for v in os.getloadavg()],
-                          "python": platform.python_version(), "numpy": np.__version__,
-                          "stonesoup": stonesoup.__version__,
-                          "ortools": ortools.__version__}}
-    out.with_suffix(".json").write_text(json.dumps(result, indent=1) + "\n")
-    out.with_suffix(".md").write_text(render(result))
-    print(render(result))
+              "machine": machine(load_start, stonesoup=stonesoup.__version__,
+                                 ortools=ortools.__version__)}
+    write_pages(out, result, render)
     return result
 
 

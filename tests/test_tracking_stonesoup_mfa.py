@@ -31,7 +31,7 @@ from stonesoup.types.track import Track  # noqa: E402
 from stonesoup.types.update import GaussianMixtureUpdate  # noqa: E402
 from stonesoup.updater.kalman import ExtendedKalmanUpdater  # noqa: E402
 
-from assocopt.tracking.stonesoup import AssocoptMFA  # noqa: E402
+from assocopt.tracking.stonesoup import AssocoptMFA, mfa_reference_cost  # noqa: E402
 
 START = datetime(2026, 1, 1)
 MM = LinearGaussian(ndim_state=4, mapping=[0, 2], noise_covar=np.diag([1.0, 1.0]))
@@ -104,21 +104,6 @@ def test_stone_soups_mfa_scene_gives_the_counts_and_tags_its_test_expects(window
         assert assoc.last_costs == [sol.objective]
 
 
-def _reference_cost(hypotheses, window):
-    """The cost of the global hypothesis Stone Soup's MFA algorithm reaches."""
-    from stonesoup.dataassociator.mfa import _init, _step
-    hyps = [_init.Hyp.create(trackID=i, cost=-np.log(h.prediction.weight),
-                             measHistory=h.prediction.tag, slide_window=window)
-            for i, mh in enumerate(hypotheses.values()) for h in mh]
-    info = _init.init_hyp_info(hyps, window)
-    state = _step.AlgorithmState.initialise(window, len(info.hyps))
-    for _ in range(_step.MAX_ITERATION_COUNT):
-        _step.algorithm_step(state, info)
-        if state.should_break:
-            break
-    return float(info.all_costs[state.get_best_hypothesis_indices()].sum())
-
-
 @pytest.mark.parametrize("window", [2, 3])
 def test_same_pruned_hypotheses_as_mfa_data_associator_and_never_a_higher_cost(window):
     from stonesoup.dataassociator.mfa import MFADataAssociator
@@ -132,7 +117,7 @@ def test_same_pruned_hypotheses_as_mfa_data_associator_and_never_a_higher_cost(w
         dets = detections_near(tracks, t, rng, n=3)
         hypotheses = ours.generate_hypotheses(set(tracks), dets, t, detections_tuple=tuple(dets))
         a = ours.associate_hypotheses(hypotheses)
-        theirs = _reference_cost(copy.copy(hypotheses), window)
+        theirs = mfa_reference_cost(copy.copy(hypotheses), window)
         assert ours.last_solution.objective <= theirs + 1e-9
         if abs(ours.last_solution.objective - theirs) <= 1e-9:   # theirs optimal too
             b = ref.associate(set(tracks), dets, t)

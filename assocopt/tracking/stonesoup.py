@@ -46,7 +46,8 @@ from ..solving.api import solve
 from ..problems.problem import AssignmentProblem
 from ..model.solution import Status
 
-__all__ = ["AssocoptGNN", "AssocoptKBest", "AssocoptMFA", "hypotheses_problem"]
+__all__ = ["AssocoptGNN", "AssocoptKBest", "AssocoptMFA", "hypotheses_problem",
+           "mfa_reference_cost"]
 
 #: Accepted values of ``probability_score``.
 PROBABILITY_SCORES = ("linear", "log")
@@ -298,3 +299,23 @@ class AssocoptMFA(DataAssociator):
         for t, hi, n in zip(order, np.cumsum(counts).tolist(), counts.tolist()):
             out[t] = MultipleHypothesis([flat[j] for j in range(hi - n, hi) if keep[j]])
         return out
+
+
+def mfa_reference_cost(hypotheses, window: int) -> float:
+    """The cost (summed ``-log(weight)``) of the global hypothesis Stone Soup's
+    :class:`~stonesoup.dataassociator.mfa.MFADataAssociator` selects from
+    ``hypotheses`` (track -> hypotheses): its own Lagrangian/SCIP steps
+    (``stonesoup.dataassociator.mfa._init`` / ``_step``, private) rerun as its
+    ``associate`` runs them, for comparing costs on the same inputs.  Reads the
+    hypotheses only."""
+    from stonesoup.dataassociator.mfa import _init, _step
+    hyps = [_init.Hyp.create(trackID=i, cost=-np.log(h.prediction.weight),
+                             measHistory=h.prediction.tag, slide_window=window)
+            for i, mh in enumerate(hypotheses.values()) for h in mh]
+    info = _init.init_hyp_info(hyps, window)
+    state = _step.AlgorithmState.initialise(window, len(info.hyps))
+    for _ in range(_step.MAX_ITERATION_COUNT):
+        _step.algorithm_step(state, info)
+        if state.should_break:
+            break
+    return float(info.all_costs[state.get_best_hypothesis_indices()].sum())
