@@ -147,6 +147,7 @@ def run_config(n: int, window: int, steps: int, seed: int, repeat: int,
             lambda: ref.associate(set(tracks), dets, t), repeat)
         sol, wp = ours.last_solution, ours.last_window
         row.update(hypotheses=int(len(wp.track)), candidates=int(wp.problem.n_candidates),
+                   dominated=int(wp.n_dominated),
                    axes=int(wp.problem.ndim), solver=sol.solver,
                    solve_s=float(min(solve_times)), status=sol.status.value,
                    ours_cost=float(sol.objective), bound=float(sol.bound),
@@ -182,6 +183,8 @@ def summary(cfg: dict) -> dict:
             "max_candidates": max(r["candidates"] for r in s), "axes": s[0]["axes"],
             "ours_s": ours, "solve_s": med(r["solve_s"] for r in s), "stonesoup_s": theirs,
             "speedup": theirs / ours, "max_ours_s": max(r["ours_s"] for r in s),
+            "max_ours_cpu_s": max(r["ours_cpu_s"] for r in s),
+            "dominated": med(r.get("dominated", 0) for r in s),
             "cpu_speedup": med(r["stonesoup_cpu_s"] for r in s) / med(r["ours_cpu_s"] for r in s),
             "all_proven": all(r["status"] == "optimal" for r in s),
             "max_gap": max(r["gap"] for r in s),
@@ -209,6 +212,32 @@ def totals(result: dict) -> str:
             f"{len(steps) - len(above)} steps.")
 
 
+def targets(result: dict) -> str:
+    """The issue's two speed targets, read off the table (CPU time and wall time)."""
+    rows = [summary(c) for c in result["configs"]]
+    big = [r for r in rows if r["targets"] >= 10 and r["window"] >= 3]
+    cpu, wall = min(r["cpu_speedup"] for r in big), min(r["speedup"] for r in big)
+    out = [f"Targets.  Window solve at least 10x faster than MFADataAssociator from 10 "
+           f"targets and window 3 up: the smallest speed-up over those {len(big)} scenes "
+           f"is {cpu:.1f}x in CPU time ({'met' if cpu >= 10 else 'NOT met'}), "
+           f"{wall:.1f}x in wall time."]
+    for r in rows:
+        if (r["targets"], r["window"]) == (50, 4):
+            ok = r["max_ours_cpu_s"] < 0.1
+            out.append(f"A 50-target, window-4 window under 100 ms: median "
+                       f"{1e3 * r['ours_cpu_s']:.0f} ms, largest {1e3 * r['max_ours_cpu_s']:.0f}"
+                       f" ms of CPU time ({'met' if ok else 'NOT met'} at every step); "
+                       f"wall time median {1e3 * r['ours_s']:.0f} ms, largest "
+                       f"{1e3 * r['max_ours_s']:.0f} ms.")
+    m = result["machine"]
+    out.append(f"Judged on CPU time: the machine's {m['cpu_count']} cores were shared at "
+               f"load {m['load_start'][0]:g}-{m['load_end'][0]:g}, so a wall-clock time "
+               "also counts the time other processes held the cores (and the wait for "
+               "the solver's worker thread to be scheduled); the process's CPU time "
+               "counts the work of all its threads and only that.")
+    return "  ".join(out)
+
+
 def render(result: dict) -> str:
     """The markdown page of a result (tests/test_benchmarks_mfa.py checks it)."""
     m = result["machine"]
@@ -228,25 +257,32 @@ def render(result: dict) -> str:
         f"average {m['load_start']} at start, {m['load_end']} at end (the cores are "
         "shared: single timings are upper bounds; ratios are measured side by side).",
         "", "## Window solve", "", totals(result), "",
-        "| targets | window | steps | hypotheses / step | candidates (max) | axes | "
+        "| targets | window | steps | hypotheses / step | dominated, left out / step | "
+        "candidates (max) | axes | "
         "AssocoptMFA s (CPU s) | of which solve s | MFADataAssociator s (CPU s) | speed-up "
         "(CPU) | "
-        "AssocoptMFA max s | ours proven, max gap | our cost <= theirs every step | "
+        "AssocoptMFA max s (CPU s) | ours proven, max gap | our cost <= theirs every step | "
         "steps theirs above optimum | same pruned hypotheses where theirs optimal |",
-        "|" + "---|" * 15]
+        "|" + "---|" * 16]
     for cfg in result["configs"]:
         r = summary(cfg)
         lines.append(
             f"| {r['targets']} | {r['window']} | {r['steps']} | {r['hypotheses']:.0f} | "
+            f"{r['dominated']:.0f} | "
             f"{r['max_candidates']} | {r['axes']} | {r['ours_s']:.4f} ({r['ours_cpu_s']:.4f}) | "
             f"{r['solve_s']:.4f} | {r['stonesoup_s']:.4f} ({r['stonesoup_cpu_s']:.4f}) | "
-            f"{r['speedup']:.1f}x ({r['cpu_speedup']:.1f}x) | {r['max_ours_s']:.4f} | "
+            f"{r['speedup']:.1f}x ({r['cpu_speedup']:.1f}x) | {r['max_ours_s']:.4f} "
+            f"({r['max_ours_cpu_s']:.4f}) | "
             f"{'yes' if r['all_proven'] else 'NO'}, {r['max_gap']:.1e} | "
             f"{'yes' if r['never_above'] else 'NO'} | {r['theirs_above']} | "
             f"{r['same_pruned']} of {r['compared']} |")
     lines += ["", "speed-up = MFADataAssociator s / AssocoptMFA s (both medians of the "
               "wall-clock times; in brackets, of the CPU times of the process, which the "
-              "load of the shared machine inflates less).", ""]
+              "load of the shared machine inflates less).  With one global hypothesis "
+              "kept (`k = 1`) AssocoptMFA leaves out of the window problem the "
+              "hypotheses a cheaper one of their track with a subset of their "
+              "detections dominates (`drop_dominated`; same optimum): the candidates "
+              "column counts what is left.", "", targets(result), ""]
     gen = [c for c in result["configs"] if "gen_stonesoup_s" in c["steps"][0]]
     for cfg in gen:
         s = cfg["steps"]
