@@ -241,3 +241,13 @@ def test_guide_mfa_figure_script_runs_the_guide_section(tmp_path):
     assert len(blocks) == 1 and "AssocoptMFA(" in blocks[0]
     out = mod.main(["--out", str(tmp_path / "fig.png")])
     assert out.stat().st_size > 10_000
+
+
+def test_log_costs_of_probabilities_floats_and_a_mix():
+    from assocopt.tracking.mfa import log_costs
+    probs = [Probability(0.5), Probability(1e-300) * Probability(1e-300), Probability(0)]
+    np.testing.assert_allclose(log_costs(probs)[:2], [np.log(2), 600 * np.log(10)])
+    assert log_costs(probs)[2] == np.inf
+    mixed = log_costs([0.25, Probability(0.25), 0.0])
+    np.testing.assert_allclose(mixed[:2], [np.log(4)] * 2)
+    assert mixed[2] == np.inf and log_costs([]).shape == (0,)

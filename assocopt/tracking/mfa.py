@@ -371,6 +371,15 @@ def tag_arrays(tags: Sequence[Sequence], window: int) -> tuple[np.ndarray, np.nd
     return arr, np.stack([arr, np.zeros_like(arr)], axis=2)
 
 
+def log_costs(weights: Sequence) -> np.ndarray:
+    """:func:`log_cost` of every weight, in one pass when all are ``Probability``
+    (their ``log_value`` read directly; no per-weight type test)."""
+    try:
+        return -np.fromiter((w.log_value for w in weights), np.float64, len(weights))
+    except AttributeError:
+        return np.array([log_cost(w) for w in weights], np.float64)
+
+
 def log_cost(weight: Any) -> float:
     """``-log(weight)`` of a float or a Stone Soup ``Probability`` (its log kept exact)."""
     log_value = getattr(weight, "log_value", None)

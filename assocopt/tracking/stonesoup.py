@@ -267,7 +267,7 @@ class AssocoptMFA(DataAssociator):
 
     def associate_hypotheses(self, hypotheses) -> dict:
         """The pruned hypotheses of already generated ``hypotheses`` (track -> list)."""
-        from .mfa import log_cost, nscan_prune, ranked_window, solve_window, tag_arrays
+        from .mfa import log_costs, nscan_prune, ranked_window, solve_window, tag_arrays
         from .mfa import window_problem
 
         if isinstance(self.k, bool) or int(self.k) != self.k or self.k < 1:
@@ -277,7 +277,7 @@ class AssocoptMFA(DataAssociator):
         track_id = np.repeat(np.arange(len(order)),
                              [len(hypotheses[t]) for t in order]).astype(np.int64)
         preds = [h.prediction for h in flat]
-        cost = np.array([log_cost(p.weight) for p in preds], np.float64)
+        cost = log_costs([p.weight for p in preds])
         history, labels = tag_arrays([p.tag for p in preds], self.slide_window)
         wp = window_problem(track_id, cost, history, n_tracks=len(order),
                             drop_dominated=bool(self.drop_dominated) and self.k == 1)
