@@ -153,8 +153,12 @@ def test_no_tracks_no_detections_and_tracks_that_come_and_go():
 
 
 class _TwoModels(ss_mfa.MFAHypothesiser):
-    """Tags (detection, hypothesiser index) over two hypothesisers: the contract of
-    Stone Soup's MHMFAHypothesiser, for versions that lack it."""
+    """Tags (detection, hypothesiser index) over two hypothesisers, weights
+    ``w_c w_h / (n_hypothesisers sum_c w_c)``: what Stone Soup's MHMFAHypothesiser
+    computes without a transition matrix.  No release ships that class yet (1.9.1,
+    the newest on PyPI when this was written, lacks it; it is in Stone Soup's
+    development sources); the test uses the real one as soon as the installed
+    Stone Soup has it."""
 
     def hypothesise(self, track, detections, timestamp, detections_tuple, **kwargs):
         from stonesoup.types.multihypothesis import MultipleHypothesis
