@@ -228,8 +228,7 @@ class AssocoptMFA(DataAssociator):
     is the window's :class:`~assocopt.Solution` (objective = the chosen hypotheses'
     summed ``-log(weight)``, bound, gap, status, times), ``last_costs`` the costs of
     the global hypotheses kept (best first) and ``last_window`` the
-    :class:`~assocopt.tracking.mfa.WindowProblem` (with ``k = 1``, dominated
-    hypotheses left out: ``drop_dominated``).
+    :class:`~assocopt.tracking.mfa.WindowProblem`.
     """
 
     hypothesiser: Hypothesiser = Property(
@@ -240,10 +239,12 @@ class AssocoptMFA(DataAssociator):
         default=None, doc="Keyword options passed to :func:`assocopt.solve` / ``kbest``")
     k: int = Property(default=1, doc="Global hypotheses whose histories pruning keeps")
     drop_dominated: bool = Property(
-        default=True,
+        default=False,
         doc="With ``k = 1``, leave out of the window problem the hypotheses that a "
             "cheaper one of their track with fewer detections dominates (same optimum, "
-            "smaller problem; :func:`assocopt.tracking.mfa.dominated`)")
+            "smaller problem; :func:`assocopt.tracking.mfa.dominated`): for back ends "
+            "whose time grows with the candidates (``highs``, ``lagrangian-exact``); "
+            "``auto``'s ``bnb`` was not faster with it (docs/benchmarks-mfa.md)")
 
     def __init__(self, *args, **kwargs):
         super().__init__(*args, **kwargs)
