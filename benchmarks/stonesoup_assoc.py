@@ -180,6 +180,30 @@ def render(result: dict) -> str:
     return "\n".join(lines)
 
 
+def command(script: str, argv) -> str:
+    """The command line a page records: ``script`` and its arguments, ``--out`` (and
+    its value) left out."""
+    given = list(argv if argv is not None else sys.argv[1:])
+    extra = [a for i, a in enumerate(given) if not a.startswith("--out")
+             and not (i and given[i - 1] == "--out")]
+    return " ".join([script] + extra)
+
+
+def machine(load_start: list, **versions: str) -> dict:
+    """The machine block of a result: cores, platform, the load average at start and
+    now, Python, numpy and the given package versions."""
+    return {"cpu_count": os.cpu_count(), "platform": platform.platform(),
+            "load_start": load_start, "load_end": [round(v, 2) for v in os.getloadavg()],
+            "python": platform.python_version(), "numpy": np.__version__, **versions}
+
+
+def write_pages(out: Path, result: dict, render) -> None:
+    """``OUT.json`` (the result) and ``OUT.md`` (``render(result)``), printed too."""
+    out.with_suffix(".json").write_text(json.dumps(result, indent=1) + "\n")
+    out.with_suffix(".md").write_text(render(result))
+    print(render(result))
+
+
 def main(argv=None) -> dict:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--sizes", default="10,100,1000")
@@ -194,18 +218,11 @@ def main(argv=None) -> dict:
     load_start = [round(v, 2) for v in os.getloadavg()]
     rows = [run_size(int(n), args.steps, args.seed, args.repeat)
             for n in args.sizes.split(",")]
-    cmd = "python benchmarks/stonesoup_assoc.py"
-    extra = [a for a in (argv if argv is not None else sys.argv[1:]) if not a.startswith("--out")]
-    result = {"command": " ".join([cmd] + extra), "rows": rows, "repeat": args.repeat,
-              "machine": {"cpu_count": os.cpu_count(), "platform": platform.platform(),
-                          "load_start": load_start,
-                          "load_end": [round(v, 2) for v in os.getloadavg()],
-                          "python": platform.python_version(), "numpy": np.__version__,
-                          "scipy": scipy.__version__, "stonesoup": stonesoup.__version__}}
-    out = Path(args.out)
-    out.with_suffix(".json").write_text(json.dumps(result, indent=1) + "\n")
-    out.with_suffix(".md").write_text(render(result))
-    print(render(result))
+    result = {"command": command("python benchmarks/stonesoup_assoc.py", argv),
+              "rows": rows, "repeat": args.repeat,
+              "machine": machine(load_start, scipy=scipy.__version__,
+                                 stonesoup=stonesoup.__version__)}
+    write_pages(Path(args.out), result, render)
     return result
 
 

@@ -254,3 +254,30 @@ def test_auto_sends_large_gated_components_to_lagrangian_exact(p):
     big = int((sp.sizes[todo] > cap).sum())        # every block here has dummies
     assert used.get("lagrangian-exact", 0) == big
     assert used.get("bnb", 0) == len(todo) - big
+
+
+def test_auto_batch_runs_bnb_at_its_own_defaults(monkeypatch):
+    """A problem whose whole ``auto`` choice is lagrangian-exact (kept axes too large
+    for bnb) but whose components suit bnb: the batch gets bnb's defaults, not the
+    lagrangian-exact options ``auto`` parsed for the whole (max_iter 500, step0 1, ...)."""
+    pytest.importorskip("numba")
+    import assocopt.solvers.bnb_batch as bb
+    from assocopt.solving.choice import choose_solver
+    rng = np.random.default_rng(4)
+    grid = np.stack(np.meshgrid(*[np.arange(3)] * 3, indexing="ij"), -1).reshape(-1, 3)[1:]
+    T = np.concatenate([np.where(grid > 0, grid + 2 * i, 0) for i in range(60)])
+    p = AssignmentProblem.sparse((120, 120, 120), T, rng.normal(size=len(T)))
+    assert choose_solver(p) == "lagrangian-exact"
+    seen = []
+    real = bb.run_batch
+
+    def spy(T, c, kp, sizes, params=None, deadline=None):
+        seen.append(dict(params or {}))
+        return real(T, c, kp, sizes, params, deadline)
+
+    monkeypatch.setattr(bb, "run_batch", spy)
+    sol = solve(p)
+    assert sol.info["decomposition"]["batched"] == 60
+    assert seen and all(set(s) <= set(bb.DEFAULTS) and all(
+        s[k] == bb.DEFAULTS[k] for k in s) for s in seen)
+    assert_optimal(p, sol)

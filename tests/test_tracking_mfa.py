@@ -8,8 +8,8 @@ import numpy as np
 import pytest
 from hypothesis import given, settings, strategies as st
 
-from assocopt.tracking.mfa import (chosen_hypotheses, nscan_prune, ranked_window,
-                                   solve_window, tag_arrays, window_problem)
+from assocopt.tracking.mfa import (chosen_hypotheses, dominated, nscan_prune,
+                                   ranked_window, solve_window, tag_arrays, window_problem)
 
 
 @st.composite
@@ -191,3 +191,52 @@ def test_every_exact_back_end_solves_the_window_problem(data, solver):
         return
     assert sol.objective == pytest.approx(every[0][0], abs=1e-6)
     assert float(cost[choice].sum()) == pytest.approx(sol.objective, abs=1e-6)
+
+
+def dominated_by_pairs(tuples, costs, free_cost):
+    """The dominance of :func:`dominated`, pair by pair in Python."""
+    out = []
+    for u, cu in zip(tuples.tolist(), costs.tolist()):
+        hit = False
+        for v, cv in zip(tuples.tolist(), costs.tolist()):
+            same = v[0] == u[0] and all(b in (0, a) for a, b in zip(u[1:], v[1:]))
+            freed = sum(a > 0 and b == 0 for a, b in zip(u[1:], v[1:]))
+            hit |= same and freed > 0 and cv + free_cost * freed < cu - 1e-12 * max(1, abs(cu))
+        out.append(hit)
+    return np.array(out, bool)
+
+
+@settings(max_examples=80)
+@given(hypothesis_sets(max_slots=4), st.sampled_from([0.0, 0.0, 0.7, -0.4]))
+def test_dropping_dominated_hypotheses_keeps_the_optimum(data, free_cost):
+    track, cost, history = data
+    full = window_problem(track, cost, history, free_cost=free_cost)
+    wp = window_problem(track, cost, history, free_cost=free_cost, drop_dominated=True)
+    U = full.n_hypotheses
+    mask = dominated(full.problem.tuples[:U], full.problem.costs[:U], free_cost)
+    assert mask.tolist() == dominated_by_pairs(full.problem.tuples[:U],
+                                               full.problem.costs[:U], free_cost).tolist()
+    assert wp.n_dominated == mask.sum() and wp.n_hypotheses == U - mask.sum()
+    assert wp.problem.n_candidates == full.problem.n_candidates - mask.sum()
+    a, _ = solve_window(full)
+    b, choice = solve_window(wp)
+    assert a.has_solution == b.has_solution
+    if a.has_solution:
+        assert b.objective == pytest.approx(a.objective, abs=1e-9)
+        unused = sum(wp.problem.sizes[1:]) - int((history[choice] > 0).sum())
+        extra = free_cost * unused                     # measurements left free
+        assert float(cost[choice].sum()) + extra == pytest.approx(b.objective, abs=1e-9)
+        assert (wp.candidate[choice] >= 0).all()
+
+
+def test_dominated_tuples_are_left_out_and_ranking_refuses_them():
+    track = np.array([0, 0, 0, 1])
+    cost = np.array([1.0, 2.0, 0.5, 0.3])
+    history = np.array([[4, 0], [4, 5], [0, 0], [4, 5]])
+    wp = window_problem(track, cost, history, drop_dominated=True)
+    assert wp.n_dominated == 2 and wp.candidate.tolist()[:3] == [-1, -1, 0]
+    sol, choice = solve_window(wp)
+    assert list(choice) == [2, 3] and sol.objective == pytest.approx(0.8)
+    with pytest.raises(ValueError, match="drop_dominated=False"):
+        ranked_window(wp, 2)
+    assert not dominated(np.zeros((0, 3), np.int64), np.zeros(0)).any()

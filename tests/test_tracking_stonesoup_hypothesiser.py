@@ -19,17 +19,14 @@ from stonesoup.models.measurement.linear import LinearGaussian  # noqa: E402
 from stonesoup.models.transition.linear import (  # noqa: E402
     CombinedLinearGaussianTransitionModel, ConstantVelocity)
 from stonesoup.predictor.kalman import KalmanPredictor  # noqa: E402
-from stonesoup.types.detection import Clutter, Detection  # noqa: E402
-from stonesoup.types.mixture import GaussianMixture  # noqa: E402
-from stonesoup.types.numeric import Probability  # noqa: E402
-from stonesoup.types.state import TaggedWeightedGaussianState  # noqa: E402
-from stonesoup.types.track import Track  # noqa: E402
+from stonesoup.types.detection import Detection  # noqa: E402
 from stonesoup.types.update import GaussianMixtureUpdate  # noqa: E402
 from stonesoup.updater.kalman import KalmanUpdater  # noqa: E402
 
 from assocopt.tracking.simulate import CrossingScenario  # noqa: E402
 from assocopt.tracking.stonesoup import AssocoptMFA  # noqa: E402
 from assocopt.tracking.stonesoup_hypothesiser import LinearGaussianMFAHypothesiser  # noqa: E402
+from assocopt.tracking.stonesoup_scenario import mixture_tracks, scan_detections  # noqa: E402
 
 START = datetime(2026, 1, 1)
 
@@ -78,15 +75,11 @@ def test_same_hypotheses_as_stone_soups_chain_over_a_tracker_run(gate, pda_kw):
     fast = LinearGaussianMFAHypothesiser.from_stonesoup(ref)
     assert fast.gate_threshold == gate
     assoc = AssocoptMFA(fast, slide_window=3)
-    tracks = [Track([GaussianMixture([TaggedWeightedGaussianState(
-        x[:, None], np.diag([1.0, 0.5, 1.0, 0.5]), timestamp=START, weight=Probability(1),
-        tag=[])])]) for x in out.truth[0]]
+    tracks = mixture_tracks(out.truth[0], START)
     n_hyp = 0
     for k, (zs, lab) in enumerate(zip(out.meas, out.labels), start=1):
         t = START + timedelta(seconds=k * sc.dt)
-        dets = {(Clutter if lab[m] < 0 else Detection)(zs[m][:, None], timestamp=t,
-                                                        measurement_model=mm)
-                for m in range(len(zs))}
+        dets = scan_detections(zs, lab, t, mm)
         dt_ = tuple(dets)
         for track in tracks:
             assert fast._batchable(list(track.state.components), list(dets), t, {})
@@ -105,9 +98,7 @@ def test_what_is_not_batched_is_stone_soups_own_answer():
     sc, out, mm, updater, pda = _run(2, 1, 2, seed=2, clutter_spatial_density=None)
     ref = MFAHypothesiser(DistanceGater(pda, Mahalanobis(), 4.0))
     fast = LinearGaussianMFAHypothesiser.from_stonesoup(ref)
-    track = Track([GaussianMixture([TaggedWeightedGaussianState(
-        out.truth[0][0][:, None], np.eye(4), timestamp=START, weight=Probability(1),
-        tag=[])])])
+    track, = mixture_tracks(out.truth[0][:1], START, covar=np.eye(4))
     t = START + timedelta(seconds=1)
     dets = {Detection(z[:, None], timestamp=t, measurement_model=mm) for z in out.meas[0]}
     assert fast._batchable(list(track.state.components), list(dets), t, {}) is None

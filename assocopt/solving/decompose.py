@@ -259,7 +259,10 @@ def _solve_parts(problem: AssignmentProblem, sp: Split, todo: np.ndarray,
             fits = (sp.sizes[todo] <= cap) & (top2.sum(axis=1) <= BNB_MAX_KEPT)
         from ..solvers.bnb_batch import solve_components
         left = _left(opts, t0)()
-        redo = solve_components(problem, T, csizes, sp, todo[fits], opts, left, out)
+        # bnb's own options only when bnb was asked for: with plain ``auto`` ``opts``
+        # holds the whole problem's choice's (lagrangian-exact's max_iter, step0, ...)
+        bnb_opts = opts if name == "bnb" else _defaults(opts)
+        redo = solve_components(problem, T, csizes, sp, todo[fits], bnb_opts, left, out)
         n_batched = int(fits.sum()) - len(redo)
         spent[redo] = True
         single = np.concatenate([redo, todo[~fits]]).astype(np.int64)

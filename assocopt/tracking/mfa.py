@@ -24,6 +24,13 @@ or only in a label such as :class:`~stonesoup.hypothesiser.mfa.MHMFAHypothesiser
 hypothesiser index) are one candidate tuple: the cheapest stands for them in the
 problem, and :func:`ranked_window` expands the others when ranking global hypotheses.
 
+A hypothesis whose history holds that of a cheaper hypothesis of its track (the same
+measurements in some slots, misses in the others) is in no optimum: swapping it for
+the cheaper one frees measurements and lowers the cost.  ``drop_dominated`` leaves
+such hypotheses out of the problem (the optimum is unchanged, the problem smaller and
+often split into more components); it changes the ranking below the best, so
+:func:`ranked_window` needs the full problem.
+
 :func:`nscan_prune` is the n-scan pruning rule: keep, for each track, the hypotheses
 that agree with the best global hypothesis (or with any of the ``k`` best) on the
 window's oldest scan, the one that leaves the window at the next scan.  Applied at
@@ -33,6 +40,7 @@ every scan, the kept hypotheses of a track then agree on every scan before the w
 from __future__ import annotations
 
 import heapq
+import itertools
 import math
 from dataclasses import dataclass
 from typing import Any, Sequence
@@ -41,8 +49,8 @@ import numpy as np
 
 from .. import AssignmentProblem, Solution, kbest, solve
 
-__all__ = ["WindowProblem", "window_problem", "chosen_hypotheses", "ranked_window",
-           "nscan_prune", "tag_arrays"]
+__all__ = ["WindowProblem", "window_problem", "dominated", "chosen_hypotheses",
+           "ranked_window", "nscan_prune", "tag_arrays"]
 
 
 @dataclass(frozen=True)
@@ -58,11 +66,16 @@ class WindowProblem:
         The input hypotheses (``history`` shape ``(H, S)``); hypotheses with
         ``cost = +inf`` (weight 0) never enter the problem.
     candidate : ndarray of int64, shape (H,)
-        Position in ``problem.tuples`` of each hypothesis's tuple (-1 for ``+inf``).
+        Position in ``problem.tuples`` of each hypothesis's tuple (-1 for ``+inf``, and
+        for a dominated tuple left out).
     representative : ndarray of int64, shape (U,)
         The cheapest hypothesis of each distinct tuple (first in input order on ties).
     measurements : list of ndarray
         Per slot, the original measurement ids in the order of their index ``1..n_s``.
+    n_dominated : int
+        Distinct tuples left out as dominated (``drop_dominated=True``; 0 otherwise).
+    drop_dominated : bool
+        Whether dominated tuples were looked for and left out.
     """
 
     problem: AssignmentProblem
@@ -72,6 +85,8 @@ class WindowProblem:
     candidate: np.ndarray
     representative: np.ndarray
     measurements: list
+    n_dominated: int = 0
+    drop_dominated: bool = False
 
     @property
     def n_tracks(self) -> int:
@@ -116,7 +131,8 @@ def _check_inputs(track, cost, history, n_tracks):
 
 
 def window_problem(track, cost, history, *, n_tracks: int | None = None,
-                   free_cost: float = 0.0, name: str = "mfa-window") -> WindowProblem:
+                   free_cost: float = 0.0, drop_dominated: bool = False,
+                   name: str = "mfa-window") -> WindowProblem:
     """The window's S-D problem (module docstring), built in bulk.
 
     Parameters
@@ -132,6 +148,9 @@ def window_problem(track, cost, history, *, n_tracks: int | None = None,
         T (default ``max(track) + 1``); every track needs a hypothesis.
     free_cost : float
         Cost of leaving one measurement unused (0: Stone Soup's false-alarm cost).
+    drop_dominated : bool
+        Leave out the tuples :func:`dominated` finds (module docstring): same optimum,
+        smaller problem; not for ranking.
     """
     track, cost, history, T = _check_inputs(track, cost, history, n_tracks)
     H, S = history.shape
@@ -153,6 +172,14 @@ def window_problem(track, cost, history, *, n_tracks: int | None = None,
     first[1:] = (srt[1:] != srt[:-1]).any(axis=1)
     group = np.cumsum(first) - 1
     representative = ok[order[first]]
+    distinct, distinct_cost = srt[first], c[order[first]]
+    n_dominated = 0
+    if drop_dominated:
+        kept = ~dominated(distinct, distinct_cost, free_cost)
+        n_dominated = int(len(kept) - kept.sum())
+        group = np.where(kept, np.cumsum(kept) - 1, -1)[group]
+        representative, distinct, distinct_cost = \
+            representative[kept], distinct[kept], distinct_cost[kept]
     candidate = np.full(H, -1, np.int64)
     candidate[ok[order]] = group
     sizes = [len(ids) for ids in measurements]
@@ -162,10 +189,52 @@ def window_problem(track, cost, history, *, n_tracks: int | None = None,
     free[np.arange(n_free), axis] = np.concatenate(
         [np.arange(1, n + 1) for n in sizes]) if n_free else []
     problem = AssignmentProblem.sparse(
-        (T, *sizes), np.concatenate([srt[first], free]).reshape(-1, 1 + S),
-        np.concatenate([c[order[first]], np.full(n_free, float(free_cost))]), name=name)
+        (T, *sizes), np.concatenate([distinct, free]).reshape(-1, 1 + S),
+        np.concatenate([distinct_cost, np.full(n_free, float(free_cost))]), name=name)
     return WindowProblem(problem, track, cost, history, candidate, representative,
-                         measurements)
+                         measurements, n_dominated, bool(drop_dominated))
+
+
+#: At most this many slots get every subset of their measurements tried by
+#: :func:`dominated` (2**S - 1 lookups per tuple); longer windows try one or two slots.
+ALL_SUBSETS_MAX_SLOTS = 8
+
+
+def dominated(tuples: np.ndarray, costs: np.ndarray, free_cost: float = 0.0
+              ) -> np.ndarray:
+    """Which distinct window tuples ``(t, m_1..m_S)`` are dominated (boolean mask).
+
+    Tuple ``u`` is dominated when the same track has a tuple ``v`` equal to ``u`` with
+    some of its measurements replaced by misses, and ``c_v + free_cost * (measurements
+    freed) < c_u`` (by more than rounding): in any global hypothesis choosing ``u``,
+    ``v`` plus the freed measurements left free is feasible and cheaper, so ``u`` is in
+    no optimum.  Found in bulk: each tuple's masked versions are looked up among the
+    tuples by a mixed-radix key (a key that would overflow int64: nothing is dropped).
+    """
+    U, N = tuples.shape
+    out = np.zeros(U, bool)
+    if U < 2 or N < 2:
+        return out
+    radix = [int(v) + 1 for v in tuples.max(axis=0)]
+    if math.prod(radix) >= 2 ** 62:
+        return out
+    mult = np.array([math.prod(radix[i + 1:]) for i in range(N)], np.int64)
+    key = tuples @ mult
+    order = np.argsort(key, kind="stable")
+    sorted_key, sorted_cost = key[order], costs[order]
+    meas, weight = tuples[:, 1:], tuples[:, 1:] * mult[1:]
+    S = N - 1
+    sizes = range(1, S + 1) if S <= ALL_SUBSETS_MAX_SLOTS else (1, 2)
+    margin = 1e-12 * np.maximum(1.0, np.abs(costs))
+    for r in sizes:
+        for slots in itertools.combinations(range(S), r):
+            cols = list(slots)
+            freed = (meas[:, cols] > 0).sum(axis=1)
+            masked = key - weight[:, cols].sum(axis=1)
+            pos = np.minimum(np.searchsorted(sorted_key, masked), U - 1)
+            found = (freed > 0) & (sorted_key[pos] == masked)
+            out |= found & (sorted_cost[pos] + free_cost * freed < costs - margin)
+    return out
 
 
 def chosen_hypotheses(wp: WindowProblem, solution: Solution) -> np.ndarray:
@@ -212,6 +281,9 @@ def ranked_window(wp: WindowProblem, k: int, solver: str = "auto", **options: An
     best of the expansions of its ``k`` best solutions are the ``k`` best global
     hypotheses (a solution ranked below ``k`` costs at least the ``k``-th of them).
     """
+    if wp.drop_dominated:
+        raise ValueError("ranked_window needs the full window problem: build it with "
+                         "drop_dominated=False (dominated hypotheses rank below the best)")
     ranked = kbest(wp.problem, k, solver=solver, **options)
     members: dict[int, np.ndarray] = {}
     ok = np.flatnonzero(wp.candidate >= 0)
@@ -297,6 +369,15 @@ def tag_arrays(tags: Sequence[Sequence], window: int) -> tuple[np.ndarray, np.nd
         return arr[:, :, 0].copy(), arr
     arr = arr.reshape(len(tags), window)
     return arr, np.stack([arr, np.zeros_like(arr)], axis=2)
+
+
+def log_costs(weights: Sequence) -> np.ndarray:
+    """:func:`log_cost` of every weight, in one pass when all are ``Probability``
+    (their ``log_value`` read directly; no per-weight type test)."""
+    try:
+        return -np.fromiter((w.log_value for w in weights), np.float64, len(weights))
+    except AttributeError:
+        return np.array([log_cost(w) for w in weights], np.float64)
 
 
 def log_cost(weight: Any) -> float:

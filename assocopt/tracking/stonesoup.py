@@ -46,7 +46,8 @@ from ..solving.api import solve
 from ..problems.problem import AssignmentProblem
 from ..model.solution import Status
 
-__all__ = ["AssocoptGNN", "AssocoptKBest", "AssocoptMFA", "hypotheses_problem"]
+__all__ = ["AssocoptGNN", "AssocoptKBest", "AssocoptMFA", "hypotheses_problem",
+           "mfa_reference_cost"]
 
 #: Accepted values of ``probability_score``.
 PROBABILITY_SCORES = ("linear", "log")
@@ -237,6 +238,13 @@ class AssocoptMFA(DataAssociator):
     solver_options: dict = Property(
         default=None, doc="Keyword options passed to :func:`assocopt.solve` / ``kbest``")
     k: int = Property(default=1, doc="Global hypotheses whose histories pruning keeps")
+    drop_dominated: bool = Property(
+        default=False,
+        doc="With ``k = 1``, leave out of the window problem the hypotheses that a "
+            "cheaper one of their track with fewer detections dominates (same optimum, "
+            "smaller problem; :func:`assocopt.tracking.mfa.dominated`): for back ends "
+            "whose time grows with the candidates (``highs``, ``lagrangian-exact``); "
+            "``auto``'s ``bnb`` was not faster with it (docs/benchmarks-mfa.md)")
 
     def __init__(self, *args, **kwargs):
         super().__init__(*args, **kwargs)
@@ -260,7 +268,7 @@ class AssocoptMFA(DataAssociator):
 
     def associate_hypotheses(self, hypotheses) -> dict:
         """The pruned hypotheses of already generated ``hypotheses`` (track -> list)."""
-        from .mfa import log_cost, nscan_prune, ranked_window, solve_window, tag_arrays
+        from .mfa import log_costs, nscan_prune, ranked_window, solve_window, tag_arrays
         from .mfa import window_problem
 
         if isinstance(self.k, bool) or int(self.k) != self.k or self.k < 1:
@@ -270,9 +278,10 @@ class AssocoptMFA(DataAssociator):
         track_id = np.repeat(np.arange(len(order)),
                              [len(hypotheses[t]) for t in order]).astype(np.int64)
         preds = [h.prediction for h in flat]
-        cost = np.array([log_cost(p.weight) for p in preds], np.float64)
+        cost = log_costs([p.weight for p in preds])
         history, labels = tag_arrays([p.tag for p in preds], self.slide_window)
-        wp = window_problem(track_id, cost, history, n_tracks=len(order))
+        wp = window_problem(track_id, cost, history, n_tracks=len(order),
+                            drop_dominated=bool(self.drop_dominated) and self.k == 1)
         opts = self.solver_options or {}
         if self.k == 1:
             sol, choice = solve_window(wp, self.solver, **opts)
@@ -291,3 +300,23 @@ class AssocoptMFA(DataAssociator):
         for t, hi, n in zip(order, np.cumsum(counts).tolist(), counts.tolist()):
             out[t] = MultipleHypothesis([flat[j] for j in range(hi - n, hi) if keep[j]])
         return out
+
+
+def mfa_reference_cost(hypotheses, window: int) -> float:
+    """The cost (summed ``-log(weight)``) of the global hypothesis Stone Soup's
+    :class:`~stonesoup.dataassociator.mfa.MFADataAssociator` selects from
+    ``hypotheses`` (track -> hypotheses): its own Lagrangian/SCIP steps
+    (``stonesoup.dataassociator.mfa._init`` / ``_step``, private) rerun as its
+    ``associate`` runs them, for comparing costs on the same inputs.  Reads the
+    hypotheses only."""
+    from stonesoup.dataassociator.mfa import _init, _step
+    hyps = [_init.Hyp.create(trackID=i, cost=-np.log(h.prediction.weight),
+                             measHistory=h.prediction.tag, slide_window=window)
+            for i, mh in enumerate(hypotheses.values()) for h in mh]
+    info = _init.init_hyp_info(hyps, window)
+    state = _step.AlgorithmState.initialise(window, len(info.hyps))
+    for _ in range(_step.MAX_ITERATION_COUNT):
+        _step.algorithm_step(state, info)
+        if state.should_break:
+            break
+    return float(info.all_costs[state.get_best_hypothesis_indices()].sum())
