@@ -221,9 +221,12 @@ class TrackAssociator:
         return bool(self.counter.open_rows.any() and self.counter.open_cols.any())
 
     def step(self, D: np.ndarray, f1: np.ndarray, f2: np.ndarray,
-             feature_m: np.ndarray | None = None) -> np.ndarray:
+             feature_m: np.ndarray | None = None, memo: dict | None = None) -> np.ndarray:
         """One scan; ``feature_m`` optionally gives :func:`pair_feature_degrees` of all
-        pairs (computed once when several associators decide the same scan)."""
+        pairs (computed once when several associators decide the same scan).  ``memo``
+        (a dict the caller empties for every scan) shares the fused degrees between
+        associators that decide that scan with equal :class:`DegreeParams` over the same
+        open rows and columns."""
         o, ctr = self.options, self.counter
         n1, n2 = ctr.delta.shape
         D, f1, f2 = np.asarray(D, float), np.asarray(f1, float), np.asarray(f2, float)
@@ -239,11 +242,13 @@ class TrackAssociator:
             if o.rule == "weighted":
                 sub = weighted_rule(Dsub, self.gate)
             else:
-                F = (pair_feature_degrees(f1[rows], f2[cols], self.params)
-                     if feature_m is None else feature_m[:, rows][:, :, cols])
-                p = self.params
-                m = fused_degree(np.concatenate([state_degree(Dsub, p.weights[0], p.d_tiny)[None],
-                                                 F]), p.fusion)
+                key = (self.params, rows.tobytes(), cols.tobytes())
+                m = None if memo is None else memo.get(key)
+                if m is None:
+                    m = self._fused(Dsub, f1[rows], f2[cols],
+                                    None if feature_m is None else feature_m[:, rows][:, :, cols])
+                    if memo is not None:
+                        memo[key] = m
                 sub = (max_degree_rule(m, o.eps) if o.rule == "max-degree" else
                        assignment_rule(m, o.eps, o.cost, o.solver))
         partner = np.full(D.shape[0], -1)
@@ -254,3 +259,11 @@ class TrackAssociator:
         ctr.update(partner)
         return out
 
+    def _fused(self, D: np.ndarray, f1: np.ndarray, f2: np.ndarray,
+               F: np.ndarray | None) -> np.ndarray:
+        """Fused degrees (4)-(7) of the open block: distances ``D``, features ``f1``,
+        ``f2`` and, when given, their feature degrees ``F``."""
+        p = self.params
+        F = pair_feature_degrees(f1, f2, p) if F is None else F
+        return fused_degree(np.concatenate([state_degree(D, p.weights[0], p.d_tiny)[None], F]),
+                            p.fusion)

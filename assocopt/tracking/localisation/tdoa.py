@@ -29,6 +29,7 @@ True
 from __future__ import annotations
 
 from dataclasses import dataclass
+from functools import cached_property
 from typing import NamedTuple
 
 import numpy as np
@@ -61,12 +62,15 @@ class TdoaSystem:
             raise ValueError(f"need baseline > 0, sigma >= 0 and three baseline angles, got "
                              f"{self.baseline!r}, {self.sigma!r}, {self.angles_deg!r}")
 
-    @property
+    @cached_property
     def stations(self) -> np.ndarray:
-        """``(4, 2)``: the main station, then the three auxiliary stations."""
+        """``(4, 2)``: the main station, then the three auxiliary stations (computed once,
+        read-only: a tracker asks for them at every scan)."""
         a = np.radians(np.asarray(self.angles_deg, dtype=float))
         s0 = np.asarray(self.main, dtype=float)
-        return np.vstack([s0, s0 + self.baseline * np.stack([np.cos(a), np.sin(a)], axis=1)])
+        st = np.vstack([s0, s0 + self.baseline * np.stack([np.cos(a), np.sin(a)], axis=1)])
+        st.flags.writeable = False
+        return st
 
     @property
     def range_sigma(self) -> float:

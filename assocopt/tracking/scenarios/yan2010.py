@@ -207,7 +207,7 @@ class Yan2010:
         """One node's track estimates ``(K, N, 4)``, ``(K, N, 4, 4)`` at scans 1..K0-1."""
         F, Q = cv_model(self.period, self.q_filter)
         K0, N = truth.shape[:2]
-        tdoa = np.stack([system.tdoa(truth[k, :, :2], rng) for k in range(K0)])
+        tdoa = system.tdoa(truth[:, :, :2], rng)             # (K0, N, 3), scan by scan
         f0, f1 = system.fix(tdoa[0]), system.fix(tdoa[1])
         if self.init == "two-point":
             x, P = two_point_init(f0.position, f0.covariance, f1.position, f1.covariance,
