@@ -19,11 +19,13 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from hypothesis import given, settings, strategies as st
 
 from assocopt.experiments.design import setting_key, trial_seed
 from assocopt.reproduce.yan2010.experiment import (FIG4_METHODS, GRID_METHODS, SENS_METHODS,
                                                    TABLE1_METHODS, THREE_NODE_METHODS,
                                                    experiments, trial)
+from assocopt.tracking.decide.max_degree import COUNTER_SEMANTICS, QualityCounter
 
 FIXTURE = Path(__file__).resolve().parent / "data" / "yan2010_trials.json"
 SKIP = ("t_decide",)                        # compute time, not a result
@@ -80,6 +82,50 @@ def test_trial_records_equal_the_old_codes(i):
         bad = {k: (got[m][k], v) for k, v in rec.items()
                if not _same(got[m][k], float("nan") if v is None else v)}
         assert not bad, (m, bad)
+
+
+def _old_update(c: QualityCounter, partner: np.ndarray) -> None:
+    """The counter update before the speed-up (every pair of the matrix), kept as the
+    reference of :meth:`QualityCounter.update` (which works on the open block)."""
+    if c.semantics == "off":
+        return
+    rows, cols = c.open_rows, c.open_cols
+    assoc = np.zeros(c.delta.shape, dtype=bool)
+    i = np.flatnonzero(rows & (partner >= 0))
+    assoc[i, partner[i]] = True
+    live = rows[:, None] & cols[None, :]
+    dec = live & ~assoc
+    if c.semantics == "seen":
+        dec &= c.seen
+    c.delta += assoc.astype(np.int64) - dec.astype(np.int64)
+    if c.semantics == "floor":
+        np.maximum(c.delta, 0, out=c.delta)
+    c.seen |= assoc
+    cand = np.argwhere(live & (c.delta >= c.fix_at))
+    if len(cand):
+        order = np.lexsort((cand[:, 0], -c.delta[cand[:, 0], cand[:, 1]]))
+        for a, b in cand[order]:
+            if c.fixed[a] < 0 and not c.col_fixed[b]:
+                c.fixed[a] = b
+                c.col_fixed[b] = True
+
+
+@given(st.integers(0, 6), st.integers(0, 6), st.integers(0, 2 ** 32 - 1),
+       st.sampled_from(COUNTER_SEMANTICS), st.integers(1, 3))
+@settings(max_examples=60, deadline=None)
+def test_counter_update_equals_the_full_matrix_reference(n1, n2, seed, semantics, fix_at):
+    """Random decisions, some in closed columns, with ties in the counts: the same
+    counts, seen pairs and fixed pairs as the old update, scan after scan."""
+    rng = np.random.default_rng(seed)
+    new, old = (QualityCounter(n1, n2, semantics, fix_at) for _ in range(2))
+    for _ in range(10):
+        partner = rng.integers(-1, n2, size=n1) if n2 else np.full(n1, -1)
+        if n2 and rng.random() < 0.5:                 # mostly a fixed pattern: pairs fix
+            partner = np.where(rng.random(n1) < 0.8, np.arange(n1) % n2, partner)
+        new.update(partner)
+        _old_update(old, partner)
+        for a in ("delta", "seen", "fixed", "col_fixed"):
+            assert np.array_equal(getattr(new, a), getattr(old, a)), a
 
 
 if __name__ == "__main__" and "--write" in sys.argv:

@@ -174,25 +174,38 @@ class QualityCounter:
         return ~self.col_fixed
 
     def update(self, partner: np.ndarray) -> None:
-        """Count the decisions of one step (``partner`` per row, -1 none) and fix pairs."""
+        """Count the decisions of one step (``partner`` per row, -1 none) and fix pairs.
+
+        Only the block of open rows and columns changes (and the count of a pair that
+        an open row took in a closed column, +1), so the work is done on that block.
+        """
         if self.semantics == "off":
             return
-        rows, cols = self.open_rows, self.open_cols
-        assoc = np.zeros(self.delta.shape, dtype=bool)
-        i = np.flatnonzero(rows & (partner >= 0))
-        assoc[i, partner[i]] = True
-        live = rows[:, None] & cols[None, :]
-        dec = live & ~assoc
+        partner = np.asarray(partner)
+        ri, cj = np.flatnonzero(self.open_rows), np.flatnonzero(self.open_cols)
+        i = ri[partner[ri] >= 0]
+        j = partner[i]
+        col_at = np.full(self.delta.shape[1], -1)
+        col_at[cj] = np.arange(len(cj))
+        row_at = np.full(self.delta.shape[0], -1)
+        row_at[ri] = np.arange(len(ri))
+        inside = col_at[j] >= 0
+        blk = np.ix_(ri, cj)
+        assoc = np.zeros((len(ri), len(cj)), dtype=bool)
+        assoc[row_at[i[inside]], col_at[j[inside]]] = True
+        dec = ~assoc
         if self.semantics == "seen":
-            dec &= self.seen
-        self.delta += assoc.astype(np.int64) - dec.astype(np.int64)
+            dec &= self.seen[blk]
+        d = self.delta[blk] + assoc.astype(np.int64) - dec.astype(np.int64)
         if self.semantics == "floor":
-            np.maximum(self.delta, 0, out=self.delta)
-        self.seen |= assoc
-        cand = np.argwhere(live & (self.delta >= self.fix_at))
+            np.maximum(d, 0, out=d)
+        self.delta[blk] = d
+        self.delta[i[~inside], j[~inside]] += 1           # outside the open block
+        self.seen[i, j] = True
+        cand = np.argwhere(d >= self.fix_at)
         if len(cand):
-            order = np.lexsort((cand[:, 0], -self.delta[cand[:, 0], cand[:, 1]]))
-            for a, b in cand[order]:                    # greedy: highest count first
+            order = np.lexsort((cand[:, 0], -d[cand[:, 0], cand[:, 1]]))
+            for a, b in zip(ri[cand[order, 0]], cj[cand[order, 1]]):   # highest count first
                 if self.fixed[a] < 0 and not self.col_fixed[b]:
                     self.fixed[a] = b
                     self.col_fixed[b] = True
