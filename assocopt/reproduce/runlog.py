@@ -1,5 +1,6 @@
-"""What a reproduction records about its own runs: wall time of every invocation that
-computed trials, and the compute time stored with the trials themselves.
+"""Running a paper's experiments and what a reproduction records about its own runs:
+the report records of every store (:func:`run_and_collect`), the wall time of every
+invocation that computed trials, and the compute time stored with the trials themselves.
 
 Both go into ``summary.json``, so the wall times a paper page quotes come from the
 command's output, not from a note taken by hand.
