@@ -13,6 +13,8 @@ from __future__ import annotations
 
 import json
 import math
+import shutil
+import subprocess
 import sys
 from functools import lru_cache
 from pathlib import Path
@@ -26,6 +28,7 @@ from assocopt.reproduce.yan2010.experiment import (FIG4_METHODS, GRID_METHODS, S
                                                    TABLE1_METHODS, THREE_NODE_METHODS,
                                                    experiments, trial)
 from assocopt.tracking.decide.max_degree import COUNTER_SEMANTICS, QualityCounter
+from conftest import load_script
 
 FIXTURE = Path(__file__).resolve().parent / "data" / "yan2010_trials.json"
 SKIP = ("t_decide",)                        # compute time, not a result
@@ -126,6 +129,19 @@ def test_counter_update_equals_the_full_matrix_reference(n1, n2, seed, semantics
         _old_update(old, partner)
         for a in ("delta", "seen", "fixed", "col_fixed"):
             assert np.array_equal(getattr(new, a), getattr(old, a)), a
+
+
+def test_speed_benchmark_compares_with_a_revision(capsys, monkeypatch):
+    """``benchmarks/yan2010_trial.py`` against HEAD: both codes give the same records."""
+    root = Path(__file__).resolve().parents[1]
+    if shutil.which("git") is None or subprocess.run(
+            ["git", "-C", str(root), "rev-parse", "HEAD"], capture_output=True).returncode:
+        pytest.skip("not a git checkout")
+    monkeypatch.chdir(root)
+    res = load_script("benchmarks/yan2010_trial.py", "bench_yan2010_trial").main(
+        ["--base", "HEAD", "--n", "10", "--reps", "1"])
+    assert res["trials"] == 7 and res["base_s"] > 0 and res["this_s"] > 0
+    assert "CPU s per trial" in capsys.readouterr().out
 
 
 if __name__ == "__main__" and "--write" in sys.argv:
