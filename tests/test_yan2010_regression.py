@@ -129,6 +129,9 @@ def test_counter_update_equals_the_full_matrix_reference(n1, n2, seed, semantics
         _old_update(old, partner)
         for a in ("delta", "seen", "fixed", "col_fixed"):
             assert np.array_equal(getattr(new, a), getattr(old, a)), a
+    if semantics != "off":
+        with pytest.raises(ValueError, match="partner must have shape"):
+            new.update(np.full(n1 + 1, -1))
 
 
 def test_speed_benchmark_compares_with_a_revision(capsys, monkeypatch):

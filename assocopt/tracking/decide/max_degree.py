@@ -182,6 +182,8 @@ class QualityCounter:
         if self.semantics == "off":
             return
         partner = np.asarray(partner)
+        if partner.shape != self.fixed.shape:
+            raise ValueError(f"partner must have shape {self.fixed.shape}, got {partner.shape}")
         ri, cj = np.flatnonzero(self.open_rows), np.flatnonzero(self.open_cols)
         i = ri[partner[ri] >= 0]
         j = partner[i]
