@@ -86,7 +86,8 @@ class TdoaSystem:
         return range_jacobian(x, self.stations)
 
     def tdoa(self, x: ArrayLike, rng: np.random.Generator | None = None) -> np.ndarray:
-        """Time differences (s) of emitters at ``x`` ``(N, 2)``; noisy when ``rng`` is given."""
+        """Time differences (s) ``(..., 3)`` of emitters at ``x`` ``(..., 2)``; noisy when ``rng``
+        is given (one draw per difference, in the order of ``x``)."""
         t = self.range_differences(x) / C_LIGHT
         if rng is not None:
             t = t + rng.normal(0.0, self.sigma, size=t.shape)
