@@ -106,3 +106,15 @@ def test_scenario_is_seeded_and_labels_are_shuffled():
         Yan2010(tracker="imm")
     three = Yan2010(n_targets=5, nodes=3).simulate(np.random.default_rng(1))
     assert len(three.x) == 3 and len(three.partners) == 3
+
+
+@pytest.mark.parametrize("tracker,init", [("ekf", "two-point"), ("kf-fix", "one-point")])
+def test_nodes_filtered_in_one_batch_equal_node_by_node(tracker, init):
+    sc = Yan2010(n_targets=9, duration=12.0, tracker=tracker, init=init, nodes=3)
+    truth = sc.trajectories(np.random.default_rng(3))
+    rng = np.random.default_rng(4)
+    tdoas = [s.tdoa(truth[:, :, :2], rng) for s in sc.systems()]
+    xs, Ps = sc.filter_nodes(sc.systems(), tdoas)
+    for s, t, x, P in zip(sc.systems(), tdoas, xs, Ps):
+        x1, P1 = sc.filter_nodes([s], [t])
+        assert np.array_equal(x, x1[0]) and np.array_equal(P, P1[0])

@@ -37,28 +37,26 @@ class Paper:
     page: str
 
 
-PAPERS: dict[str, Paper] = {
-    "lu2013": Paper("lu2013", "002",
-                    "Lu et al. 2013, multi-passive-sensor data association with KLD/SKLD "
-                    "costs: Fig. 1-2, Tables 1-4",
-                    1000, lu2013.run, "docs/papers/lu2013.md"),
-    "zhang2009": Paper("zhang2009", "000",
-                       "Zhang et al. 2009, group member matching with position + attribute "
-                       "beliefs: Figs. 1-5, Table 1",
-                       1000, zhang2009.run, "docs/papers/zhang2009.md"),
-    "xue1999": Paper("xue1999", "003",
-                     "Xue et al. 1999, distributed inference decision (DID) against GNN and "
-                     "nearest neighbour on four crossing targets",
-                     200, xue1999.run, "docs/papers/xue1999.md"),
-    "yan2010": Paper("yan2010", "001",
-                     "Yan et al. 2010, multi-feature D-S track-to-track association for "
-                     "passive TDOA systems: Table 1, Fig. 4",
-                     100, yan2010.run, "docs/papers/yan2010.md"),
-    "dong2015": Paper("dong2015", "004",
-                      "Dong et al. 2015, anti-bias track association by topology statistical "
-                      "distance: Figs. 2-7, time per step in place of Table 1",
-                      50, dong2015.run, "docs/papers/dong2015.md"),
-}
+def _paper(module: Any, spec: str, title: str, default_runs: int) -> Paper:
+    """The entry of the reproduction in ``module`` (its ``run``; page
+    ``docs/papers/NAME.md``)."""
+    name = module.__name__.rsplit(".", 1)[-1]
+    return Paper(name, spec, title, default_runs, module.run, f"docs/papers/{name}.md")
+
+
+PAPERS: dict[str, Paper] = {p.name: p for p in (
+    _paper(lu2013, "002", "Lu et al. 2013, multi-passive-sensor data association with KLD/SKLD "
+                          "costs: Fig. 1-2, Tables 1-4", 1000),
+    _paper(zhang2009, "000", "Zhang et al. 2009, group member matching with position + "
+                             "attribute beliefs: Figs. 1-5, Table 1", 1000),
+    _paper(xue1999, "003", "Xue et al. 1999, distributed inference decision (DID) against GNN "
+                           "and nearest neighbour on four crossing targets", 200),
+    _paper(yan2010, "001", "Yan et al. 2010, multi-feature D-S track-to-track association for "
+                           "passive TDOA systems: Table 1, Fig. 4", 100),
+    _paper(dong2015, "004", "Dong et al. 2015, anti-bias track association by topology "
+                            "statistical distance: Figs. 2-7, time per step in place of "
+                            "Table 1", 50),
+)}
 
 
 def list_papers() -> list[dict[str, Any]]:

@@ -1,5 +1,6 @@
-"""What a reproduction records about its own runs: wall time of every invocation that
-computed trials, and the compute time stored with the trials themselves.
+"""Running a paper's experiments and what a reproduction records about its own runs:
+the report records of every store (:func:`run_and_collect`), the wall time of every
+invocation that computed trials, and the compute time stored with the trials themselves.
 
 Both go into ``summary.json``, so the wall times a paper page quotes come from the
 command's output, not from a note taken by hand.
@@ -10,11 +11,11 @@ from __future__ import annotations
 import json
 import sqlite3
 from pathlib import Path
-from typing import Any, Mapping, Sequence
+from typing import Any, Callable, Mapping, Sequence
 
-from ..experiments import run_all
+from ..experiments import report_records, run_all, summarise
 
-__all__ = ["run_timed", "timing_history", "trial_seconds"]
+__all__ = ["run_timed", "run_and_collect", "timing_history", "trial_seconds"]
 
 
 def run_timed(exps: Sequence[Any], out: Path, *, runs: int, workers: int, seed: int,
@@ -28,6 +29,31 @@ def run_timed(exps: Sequence[Any], out: Path, *, runs: int, workers: int, seed: 
                              workers=workers, seed=seed, options=options)
     return {"timing": timing, "timing_history": history,
             "trial_seconds": trial_seconds(out, [e.name for e in exps])}
+
+
+def run_and_collect(exps: Sequence[Any], out: Path, by: Sequence[str], *, runs: int,
+                    workers: int, seed: int, options: Mapping[str, Any] | None = None,
+                    executor: Any = None, progress: bool = False,
+                    extra_rows: Callable[[Path, Any], list] | None = None,
+                    flag: Callable[[Any, dict], bool] | None = None
+                    ) -> tuple[dict[str, Any], list[dict[str, Any]]]:
+    """Run (or resume) ``exps`` into ``out`` (:func:`run_timed`) and gather the report
+    records of every store ``out/NAME.sqlite``, settings keyed by ``by``.
+
+    ``extra_rows(store, exp)`` gives more rows reported with the store's own (paired
+    differences); ``flag(exp, record)`` sets a record's flags in place and says whether
+    it goes into ``summary.json``.  Returns the timing entries and the records.
+    """
+    timed = run_timed(exps, out, runs=runs, workers=workers, seed=seed, options=options,
+                      executor=executor, progress=progress)
+    records: list[dict[str, Any]] = []
+    for exp in exps:
+        store = Path(out) / f"{exp.name}.sqlite"
+        rows = summarise(store, exp, include_volatile=True)
+        if extra_rows is not None:
+            rows = rows + extra_rows(store, exp)
+        records += [r for r in report_records(rows, exp, by) if flag is None or flag(exp, r)]
+    return timed, records
 
 
 def timing_history(previous_summary: Path, timing: Mapping[str, Mapping[str, Any]], *,

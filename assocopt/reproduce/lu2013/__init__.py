@@ -33,7 +33,7 @@ from typing import Any, Mapping, Sequence
 
 from ...tracking.costs.sd_builder import COSTS
 from .._report import write_report
-from ..runlog import run_timed
+from ..runlog import run_and_collect
 from .divergence import printed_kld_summary
 from .experiment import (D_GRID, DEFAULTS, DISAGREEMENT_PAIRS, METHODS,  # noqa: F401
                          OURS_PARAMS, PAPER_FIG2_GAIN, PAPER_LABELS, PAPER_TABLES, PRINTED,
@@ -52,35 +52,31 @@ __all__ = ["METHODS", "PAPER_TABLES", "PAPER_FIG2_GAIN", "DEFAULTS", "experiment
 def run(runs: int, workers: int, seed: int, out, *, progress: bool = False,
         executor: Any = None, options: Mapping[str, Any] | None = None,
         parts: Sequence[str] = ("fig", "tables", "region"), echo=print) -> dict[str, Any]:
-    """Run (or resume) the reproduction into ``out`` and write its report files.
-
-    Writes ``out/summary.json``, ``out/tables.md``, the figures (when matplotlib is
-    installed) and the stores ``out/lu2013-*.sqlite``; prints the tables with
-    ``echo``.  ``summary.json`` keeps, under ``timing_history``, the wall time of every
-    invocation into ``out`` that computed trials.  Returns the summary dict.
-    """
+    """Run (or resume) the reproduction into ``out`` and write its report files
+    (:func:`assocopt.reproduce.reproduce`; stores ``out/lu2013-*.sqlite``)."""
     from pathlib import Path
 
-    from ...experiments import paired_differences, report_records, summarise
+    from ...experiments import paired_differences
     from ...io.writers import jsonable
+
+    def paired(store, exp) -> list:
+        return [r for metric in ("tuple_rate", "partition_correct")
+                for r in paired_differences(store, exp, metric, "pattipati")]
+
+    def flag(exp, r: dict[str, Any]) -> bool:
+        r["paired"] = " - " in r["metric"]
+        return True
 
     out = Path(out)
     exps = experiments(runs, seed, options, parts)
-    timed = run_timed(exps, out, runs=runs, workers=workers, seed=seed, options=options,
-                      executor=executor, progress=progress)
-    records: list[dict[str, Any]] = []
+    timed, records = run_and_collect(exps, out, ("sigma_mrad", "d", "M", "line_direction", "L"),
+                                     runs=runs, workers=workers, seed=seed, options=options,
+                                     executor=executor, progress=progress,
+                                     extra_rows=paired, flag=flag)
     disagreements = []
     for exp in exps:
-        store = out / f"{exp.name}.sqlite"
-        paired = []
-        for metric in ("tuple_rate", "partition_correct"):
-            paired += paired_differences(store, exp, metric, "pattipati")
-        rows = summarise(store, exp, include_volatile=True) + paired
-        for r in report_records(rows, exp, ("sigma_mrad", "d", "M", "line_direction", "L")):
-            r["paired"] = " - " in r["metric"]
-            records.append(r)
         if exp.params["experiment"] == "tables":
-            ld = exp.settings[0]["line_direction"]
+            store, ld = out / f"{exp.name}.sqlite", exp.settings[0]["line_direction"]
             for a, b in DISAGREEMENT_PAIRS:
                 if {a, b} <= set(exp.methods):
                     disagreements.append({"line_direction": ld, "a": a, "b": b,

@@ -21,8 +21,7 @@ from __future__ import annotations
 from pathlib import Path
 from typing import Any, Mapping, Sequence
 
-from ...experiments import report_records, summarise
-from ..runlog import run_timed
+from ..runlog import run_and_collect
 from .._report import write_report
 from .experiment import (DEFAULTS, LABELS, METHODS, PAPER_CLAIMS, PAPER_METHODS,  # noqa: F401
                          PAPER_TABLE1, SENS_VARIANTS, TABLE1_N, experiments, parameters, trial)
@@ -44,25 +43,17 @@ def _kept(metric: str) -> bool:
 def run(runs: int, workers: int, seed: int, out, *, progress: bool = False,
         executor: Any = None, options: Mapping[str, Any] | None = None,
         parts: Sequence[str] = PARTS, echo=print) -> dict[str, Any]:
-    """Run (or resume) the reproduction into ``out`` and write its report files.
+    """Run (or resume) the reproduction into ``out`` and write its report files
+    (:func:`assocopt.reproduce.reproduce`; stores ``out/yan2010-*.sqlite``)."""
+    def flag(exp, r: dict[str, Any]) -> bool:
+        r["method_is_ours"] = r["method"] not in PAPER_METHODS
+        return exp.params["experiment"] not in ("grid", "confirm") or _kept(r["metric"])
 
-    Writes ``out/summary.json``, ``out/tables.md``, PNG figures (when matplotlib is
-    installed) and the stores ``out/yan2010-*.sqlite``; prints the tables with
-    ``echo``.  ``summary.json`` keeps, under ``timing_history``, the wall time of every
-    invocation into ``out`` that computed trials.  Returns the summary dict.
-    """
     out = Path(out)
-    exps = experiments(runs, seed, options, parts)
-    timed = run_timed(exps, out, runs=runs, workers=workers, seed=seed, options=options,
-                      executor=executor, progress=progress)
-    records: list[dict[str, Any]] = []
-    for exp in exps:
-        rows = summarise(out / f"{exp.name}.sqlite", exp, include_volatile=True)
-        for r in report_records(rows, exp, ("n", "variant", "features", "coverage")):
-            if exp.params["experiment"] in ("grid", "confirm") and not _kept(r["metric"]):
-                continue                    # in the stores, not in summary.json
-            r["method_is_ours"] = r["method"] not in PAPER_METHODS
-            records.append(r)
+    timed, records = run_and_collect(experiments(runs, seed, options, parts), out,
+                                     ("n", "variant", "features", "coverage"), runs=runs,
+                                     workers=workers, seed=seed, options=options,
+                                     executor=executor, progress=progress, flag=flag)
     methods = sorted({r["method"] for r in records})
     summary = {
         "paper": "yan2010",

@@ -195,6 +195,7 @@ def trial(setting: Mapping[str, Any], methods: Sequence[str],
             D = _block(n1, n2, r, c, np.inf, lambda r, c: statistical_distance(
                 run.x[0][k][r], run.P[0][k][r], run.x[1][k][c], run.P[1][k][c]))
             F = {}                          # feature degrees, once per tolerance set
+            memo: dict = {}                 # fused degrees, once per (params, open set)
         for m in live:
             t0 = time.perf_counter()
             if m in busy:
@@ -203,7 +204,7 @@ def trial(setting: Mapping[str, Any], methods: Sequence[str],
                 if key not in F:
                     F[key] = _block(n1, n2, r, c, 0.0, lambda r, c, q=a.params:
                                     pair_feature_degrees(f1[r], f2[c], q), lead=(3,))
-                p = a.step(D, f1, f2, F[key])
+                p = a.step(D, f1, f2, F[key], memo)
             else:                           # nothing open: the fixed pairs stand
                 fx = assoc[m].counter.fixed
                 p = np.where(fx >= 0, fx, -1)

@@ -27,10 +27,9 @@ from __future__ import annotations
 from pathlib import Path
 from typing import Any, Mapping, Sequence
 
-from ...experiments import report_records, summarise
 from ...io.writers import jsonable
 from .._report import write_report
-from ..runlog import run_timed
+from ..runlog import run_and_collect
 from .experiment import (DEFAULTS, LABELS, MAIN_METHODS, METHODS, PAIRS,  # noqa: F401
                          PAPER_CLAIMS, PAPER_METHODS, PAPER_TABLE1, R, TABLE1_METHODS,
                          TABLE1_PD, VOLATILE, W, _measure_params, _options, experiments,
@@ -45,23 +44,17 @@ def run(runs: int, workers: int, seed: int, out, *, progress: bool = False,
         executor: Any = None, options: Mapping[str, Any] | None = None,
         parts: Sequence[str] = ("main", "weights", "table1", "sensitivity"),
         echo=print) -> dict[str, Any]:
-    """Run (or resume) the reproduction into ``out`` and write its report files.
+    """Run (or resume) the reproduction into ``out`` and write its report files
+    (:func:`assocopt.reproduce.reproduce`; stores ``out/zhang2009-*.sqlite``)."""
+    def flag(exp, r: dict[str, Any]) -> bool:
+        r["method_is_ours"] = r["method"] not in PAPER_METHODS
+        return True
 
-    Writes ``out/summary.json``, ``out/tables.md``, PNG figures (when matplotlib is
-    installed) and the stores ``out/zhang2009-*.sqlite``; prints the tables with
-    ``echo``.  ``summary.json`` keeps, under ``timing_history``, the wall time of every
-    invocation into ``out`` that computed trials.  Returns the summary dict.
-    """
     out = Path(out)
     exps = experiments(runs, seed, options, parts)
-    timed = run_timed(exps, out, runs=runs, workers=workers, seed=seed, options=options,
-                      executor=executor, progress=progress)
-    records: list[dict[str, Any]] = []
-    for exp in exps:
-        rows = summarise(out / f"{exp.name}.sqlite", exp, include_volatile=True)
-        for r in report_records(rows, exp, ("sweep", "f", "p_d", "k")):
-            r["method_is_ours"] = r["method"] not in PAPER_METHODS
-            records.append(r)
+    timed, records = run_and_collect(exps, out, ("sweep", "f", "p_d", "k"), runs=runs,
+                                     workers=workers, seed=seed, options=options,
+                                     executor=executor, progress=progress, flag=flag)
     paired = []
     for exp in exps:
         paired += paired_differences(out / f"{exp.name}.sqlite", exp)

@@ -174,25 +174,40 @@ class QualityCounter:
         return ~self.col_fixed
 
     def update(self, partner: np.ndarray) -> None:
-        """Count the decisions of one step (``partner`` per row, -1 none) and fix pairs."""
+        """Count the decisions of one step (``partner`` per row, -1 none) and fix pairs.
+
+        Only the block of open rows and columns changes (and the count of a pair that
+        an open row took in a closed column, +1), so the work is done on that block.
+        """
         if self.semantics == "off":
             return
-        rows, cols = self.open_rows, self.open_cols
-        assoc = np.zeros(self.delta.shape, dtype=bool)
-        i = np.flatnonzero(rows & (partner >= 0))
-        assoc[i, partner[i]] = True
-        live = rows[:, None] & cols[None, :]
-        dec = live & ~assoc
+        partner = np.asarray(partner)
+        if partner.shape != self.fixed.shape:
+            raise ValueError(f"partner must have shape {self.fixed.shape}, got {partner.shape}")
+        ri, cj = np.flatnonzero(self.open_rows), np.flatnonzero(self.open_cols)
+        i = ri[partner[ri] >= 0]
+        j = partner[i]
+        col_at = np.full(self.delta.shape[1], -1)
+        col_at[cj] = np.arange(len(cj))
+        row_at = np.full(self.delta.shape[0], -1)
+        row_at[ri] = np.arange(len(ri))
+        inside = col_at[j] >= 0
+        blk = np.ix_(ri, cj)
+        assoc = np.zeros((len(ri), len(cj)), dtype=bool)
+        assoc[row_at[i[inside]], col_at[j[inside]]] = True
+        dec = ~assoc
         if self.semantics == "seen":
-            dec &= self.seen
-        self.delta += assoc.astype(np.int64) - dec.astype(np.int64)
+            dec &= self.seen[blk]
+        d = self.delta[blk] + assoc.astype(np.int64) - dec.astype(np.int64)
         if self.semantics == "floor":
-            np.maximum(self.delta, 0, out=self.delta)
-        self.seen |= assoc
-        cand = np.argwhere(live & (self.delta >= self.fix_at))
+            np.maximum(d, 0, out=d)
+        self.delta[blk] = d
+        self.delta[i[~inside], j[~inside]] += 1           # outside the open block
+        self.seen[i, j] = True
+        cand = np.argwhere(d >= self.fix_at)
         if len(cand):
-            order = np.lexsort((cand[:, 0], -self.delta[cand[:, 0], cand[:, 1]]))
-            for a, b in cand[order]:                    # greedy: highest count first
+            order = np.lexsort((cand[:, 0], -d[cand[:, 0], cand[:, 1]]))
+            for a, b in zip(ri[cand[order, 0]], cj[cand[order, 1]]):   # highest count first
                 if self.fixed[a] < 0 and not self.col_fixed[b]:
                     self.fixed[a] = b
                     self.col_fixed[b] = True
@@ -221,9 +236,12 @@ class TrackAssociator:
         return bool(self.counter.open_rows.any() and self.counter.open_cols.any())
 
     def step(self, D: np.ndarray, f1: np.ndarray, f2: np.ndarray,
-             feature_m: np.ndarray | None = None) -> np.ndarray:
+             feature_m: np.ndarray | None = None, memo: dict | None = None) -> np.ndarray:
         """One scan; ``feature_m`` optionally gives :func:`pair_feature_degrees` of all
-        pairs (computed once when several associators decide the same scan)."""
+        pairs (computed once when several associators decide the same scan).  ``memo``
+        (a dict the caller empties for every scan) shares the fused degrees between
+        associators that decide that scan with equal :class:`DegreeParams` over the same
+        open rows and columns."""
         o, ctr = self.options, self.counter
         n1, n2 = ctr.delta.shape
         D, f1, f2 = np.asarray(D, float), np.asarray(f1, float), np.asarray(f2, float)
@@ -239,11 +257,13 @@ class TrackAssociator:
             if o.rule == "weighted":
                 sub = weighted_rule(Dsub, self.gate)
             else:
-                F = (pair_feature_degrees(f1[rows], f2[cols], self.params)
-                     if feature_m is None else feature_m[:, rows][:, :, cols])
-                p = self.params
-                m = fused_degree(np.concatenate([state_degree(Dsub, p.weights[0], p.d_tiny)[None],
-                                                 F]), p.fusion)
+                key = (self.params, rows.tobytes(), cols.tobytes())
+                m = None if memo is None else memo.get(key)
+                if m is None:
+                    m = self._fused(Dsub, f1[rows], f2[cols],
+                                    None if feature_m is None else feature_m[:, rows][:, :, cols])
+                    if memo is not None:
+                        memo[key] = m
                 sub = (max_degree_rule(m, o.eps) if o.rule == "max-degree" else
                        assignment_rule(m, o.eps, o.cost, o.solver))
         partner = np.full(D.shape[0], -1)
@@ -254,3 +274,11 @@ class TrackAssociator:
         ctr.update(partner)
         return out
 
+    def _fused(self, D: np.ndarray, f1: np.ndarray, f2: np.ndarray,
+               F: np.ndarray | None) -> np.ndarray:
+        """Fused degrees (4)-(7) of the open block: distances ``D``, features ``f1``,
+        ``f2`` and, when given, their feature degrees ``F``."""
+        p = self.params
+        F = pair_feature_degrees(f1, f2, p) if F is None else F
+        return fused_degree(np.concatenate([state_degree(D, p.weights[0], p.d_tiny)[None], F]),
+                            p.fusion)

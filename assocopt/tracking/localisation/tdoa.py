@@ -29,12 +29,13 @@ True
 from __future__ import annotations
 
 from dataclasses import dataclass
+from functools import cached_property
 from typing import NamedTuple
 
 import numpy as np
 from numpy.typing import ArrayLike
 
-__all__ = ["C_LIGHT", "TdoaSystem", "TdoaFix"]
+__all__ = ["C_LIGHT", "TdoaSystem", "TdoaFix", "range_differences", "range_jacobian"]
 
 #: Speed of light (m/s).
 C_LIGHT = 299_792_458.0
@@ -61,12 +62,15 @@ class TdoaSystem:
             raise ValueError(f"need baseline > 0, sigma >= 0 and three baseline angles, got "
                              f"{self.baseline!r}, {self.sigma!r}, {self.angles_deg!r}")
 
-    @property
+    @cached_property
     def stations(self) -> np.ndarray:
-        """``(4, 2)``: the main station, then the three auxiliary stations."""
+        """``(4, 2)``: the main station, then the three auxiliary stations (computed once,
+        read-only: a tracker asks for them at every scan)."""
         a = np.radians(np.asarray(self.angles_deg, dtype=float))
         s0 = np.asarray(self.main, dtype=float)
-        return np.vstack([s0, s0 + self.baseline * np.stack([np.cos(a), np.sin(a)], axis=1)])
+        st = np.vstack([s0, s0 + self.baseline * np.stack([np.cos(a), np.sin(a)], axis=1)])
+        st.flags.writeable = False
+        return st
 
     @property
     def range_sigma(self) -> float:
@@ -75,19 +79,15 @@ class TdoaSystem:
 
     def range_differences(self, x: ArrayLike) -> np.ndarray:
         """``|x - s_k| - |x - s0|`` for ``x`` ``(..., 2)`` -> ``(..., 3)`` (m)."""
-        x = np.asarray(x, dtype=float)
-        r = np.linalg.norm(x[..., None, :] - self.stations, axis=-1)
-        return r[..., 1:] - r[..., :1]
+        return range_differences(x, self.stations)
 
     def jacobian(self, x: ArrayLike) -> np.ndarray:
         """Jacobian of :meth:`range_differences` with respect to position, ``(..., 3, 2)``."""
-        x = np.asarray(x, dtype=float)
-        d = x[..., None, :] - self.stations
-        u = d / np.linalg.norm(d, axis=-1, keepdims=True)
-        return u[..., 1:, :] - u[..., :1, :]
+        return range_jacobian(x, self.stations)
 
     def tdoa(self, x: ArrayLike, rng: np.random.Generator | None = None) -> np.ndarray:
-        """Time differences (s) of emitters at ``x`` ``(N, 2)``; noisy when ``rng`` is given."""
+        """Time differences (s) ``(..., 3)`` of emitters at ``x`` ``(..., 2)``; noisy when ``rng``
+        is given (one draw per difference, in the order of ``x``)."""
         t = self.range_differences(x) / C_LIGHT
         if rng is not None:
             t = t + rng.normal(0.0, self.sigma, size=t.shape)
@@ -108,3 +108,20 @@ class TdoaSystem:
         Ju = J[..., :2, :]
         P = self.range_sigma ** 2 * Ju @ np.swapaxes(Ju, -1, -2)
         return TdoaFix(theta[..., :2] + st[0], P)
+
+
+def range_differences(x: ArrayLike, stations: np.ndarray) -> np.ndarray:
+    """``|x - s_k| - |x - s0|`` for ``x`` ``(..., 2)`` and ``stations`` ``(4, 2)``, or one
+    set of stations per point ``(..., 4, 2)`` (several systems' tracks in one batch)
+    -> ``(..., 3)`` (m)."""
+    x = np.asarray(x, dtype=float)
+    r = np.linalg.norm(x[..., None, :] - stations, axis=-1)
+    return r[..., 1:] - r[..., :1]
+
+
+def range_jacobian(x: ArrayLike, stations: np.ndarray) -> np.ndarray:
+    """Jacobian of :func:`range_differences` with respect to position, ``(..., 3, 2)``."""
+    x = np.asarray(x, dtype=float)
+    d = x[..., None, :] - stations
+    u = d / np.linalg.norm(d, axis=-1, keepdims=True)
+    return u[..., 1:, :] - u[..., :1, :]

@@ -43,7 +43,7 @@ from typing import NamedTuple
 import numpy as np
 
 from ..filters import cv_model, predict, two_point_init, update
-from ..localisation.tdoa import C_LIGHT, TdoaSystem
+from ..localisation.tdoa import C_LIGHT, TdoaSystem, range_differences, range_jacobian
 
 __all__ = ["PAPER", "OURS", "TRACKERS", "INITS", "Yan2010", "Yan2010Run"]
 
@@ -204,36 +204,59 @@ class Yan2010:
     # ------------------------------------------------------------------ tracking
     def track(self, system: TdoaSystem, truth: np.ndarray, rng: np.random.Generator
               ) -> tuple[np.ndarray, np.ndarray]:
-        """One node's track estimates ``(K, N, 4)``, ``(K, N, 4, 4)`` at scans 1..K0-1."""
+        """One node's track estimates ``(K, N, 4)``, ``(K, N, 4, 4)`` at scans 1..K0-1
+        (its TDOA noise drawn from ``rng``)."""
+        xs, Ps = self.filter_nodes([system], [system.tdoa(truth[:, :, :2], rng)])
+        return xs[0], Ps[0]
+
+    def filter_nodes(self, systems: list[TdoaSystem], tdoas: list[np.ndarray]
+                     ) -> tuple[list[np.ndarray], list[np.ndarray]]:
+        """Every node's track estimates (as :meth:`track`) from its measured TDOAs
+        ``(K0, N, 3)``: the nodes' filters run as one batch of ``nodes * N`` tracks (each
+        with its own stations and noise), so a scan costs one filter step, not one per
+        node."""
         F, Q = cv_model(self.period, self.q_filter)
-        K0, N = truth.shape[:2]
-        tdoa = np.stack([system.tdoa(truth[k, :, :2], rng) for k in range(K0)])
-        f0, f1 = system.fix(tdoa[0]), system.fix(tdoa[1])
-        if self.init == "two-point":
-            x, P = two_point_init(f0.position, f0.covariance, f1.position, f1.covariance,
-                                  self.period)
-            xs, Ps, first = [x], [P], 2
+        K0, N = tdoas[0].shape[:2]
+        x, P = (np.concatenate(a) for a in zip(*(self._init(s, t) for s, t in
+                                                  zip(systems, tdoas))))
+        first = 2 if self.init == "two-point" else 1
+        xs, Ps = ([x], [P]) if first == 2 else ([], [])
+        if self.tracker == "ekf":
+            st = np.repeat(np.stack([s.stations for s in systems]), N, axis=0)   # (nodes N, 4, 2)
+            R = np.repeat(np.stack([s.range_sigma ** 2 * np.eye(3) for s in systems]), N, axis=0)
+            z = C_LIGHT * np.concatenate(tdoas, axis=1)                        # range differences
         else:
-            x = np.concatenate([f0.position, np.zeros((N, 2))], axis=1)
-            vv = PAPER["speed_range_mps"][1] ** 2 / 2 * np.eye(2)   # E|v|^2 / 2 per axis
-            P = np.zeros((N, 4, 4))
-            P[:, :2, :2], P[:, 2:, 2:] = f0.covariance, vv
-            xs, Ps, first = [], [], 1
-        R = system.range_sigma ** 2 * np.eye(3)
-        Hpos = np.hstack([np.eye(2), np.zeros((2, 2))])
+            fixes = [s.fix(t) for s, t in zip(systems, tdoas)]
+            z = np.concatenate([f.position for f in fixes], axis=1)
+            R = np.concatenate([f.covariance for f in fixes], axis=1)
+            Hpos = np.hstack([np.eye(2), np.zeros((2, 2))])
         for k in range(first, K0):
             x, P = predict(x, P, F, Q)
             if self.tracker == "ekf":
-                J = system.jacobian(x[:, :2])
+                J = range_jacobian(x[:, :2], st)
                 H = np.concatenate([J, np.zeros(J.shape)], axis=-1)
-                res = C_LIGHT * tdoa[k] - system.range_differences(x[:, :2])
-                x, P = update(x, P, res, H, R)
+                x, P = update(x, P, z[k] - range_differences(x[:, :2], st), H, R)
             else:
-                fx = system.fix(tdoa[k])
-                x, P = update(x, P, fx.position - x[:, :2], Hpos, fx.covariance)
+                x, P = update(x, P, z[k] - x[:, :2], Hpos, R[k])
             xs.append(x)
             Ps.append(P)
-        return np.stack(xs), np.stack(Ps)
+        X, PP = np.stack(xs), np.stack(Ps)
+        cut = [slice(n * N, (n + 1) * N) for n in range(len(systems))]
+        return [X[:, c] for c in cut], [PP[:, c] for c in cut]
+
+    def _init(self, system: TdoaSystem, tdoa: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """A node's initial state and covariance: at the second scan from the first two
+        fixes (``"two-point"``), or at the first from its fix (``"one-point"``)."""
+        f0, f1 = system.fix(tdoa[0]), system.fix(tdoa[1])
+        if self.init == "two-point":
+            return two_point_init(f0.position, f0.covariance, f1.position, f1.covariance,
+                                  self.period)
+        N = tdoa.shape[1]
+        x = np.concatenate([f0.position, np.zeros((N, 2))], axis=1)
+        vv = PAPER["speed_range_mps"][1] ** 2 / 2 * np.eye(2)   # E|v|^2 / 2 per axis
+        P = np.zeros((N, 4, 4))
+        P[:, :2, :2], P[:, 2:, 2:] = f0.covariance, vv
+        return x, P
 
     def coverage(self, rng: np.random.Generator) -> np.ndarray:
         """``(nodes, N)`` bool: which node sees which emitter (``single_node_fraction``
@@ -258,14 +281,13 @@ class Yan2010:
         emit = self.emitters(rng)
         sig = self.feature_sigmas()
         K = truth.shape[0] - 1
-        xs, Ps, feats = [], [], []
+        tdoas, feats = [], []
         perms = [np.arange(N)] + [rng.permutation(N) for _ in range(self.nodes - 1)]
-        for n, system in enumerate(self.systems()):
-            x, P = self.track(system, truth, rng)
-            f = emit[None] + rng.normal(size=(K, N, 3)) * sig[n]
-            xs.append(x)
-            Ps.append(P)
-            feats.append(f)
+        systems = self.systems()
+        for n, system in enumerate(systems):       # draws node by node: TDOAs, features
+            tdoas.append(system.tdoa(truth[:, :, :2], rng))
+            feats.append(emit[None] + rng.normal(size=(K, N, 3)) * sig[n])
+        xs, Ps = self.filter_nodes(systems, tdoas)
         seen = self.coverage(rng)
         emitter_of = tuple(p[seen[n][p]] for n, p in enumerate(perms))   # node n's track j
         where = np.full((self.nodes, N), -1)
