@@ -539,7 +539,12 @@ def _trial_numbers(folder: Path) -> dict[str, list]:
 class TestDistributed:
     """A real ``LocalCluster`` (2 worker processes) runs the trials."""
 
-    def test_reproduce_on_dask_equals_one_worker(self, dask_cluster, tmp_path, capsys):
+    def test_reproduce_on_dask_equals_one_worker(self, dask_cluster, tmp_path, capsys,
+                                                 monkeypatch):
+        """Both runs with zhang2009's Table 1 enumeration capped at 100000 nodes (the
+        settings carry the cap to the workers; the default 2 million cost 11 s a run)."""
+        from assocopt.reproduce.zhang2009 import experiment
+        monkeypatch.setitem(experiment.DEFAULTS, "enum_max_nodes", 100_000)
         cluster, _ = dask_cluster
         local, remote = tmp_path / "local", tmp_path / "dask"
         assert cli(capsys, "reproduce", "zhang2009", "--runs", "1", "--workers", "1",
