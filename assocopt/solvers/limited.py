@@ -66,15 +66,17 @@ def run_limited(target: str, args: tuple, limit: float, start: float) -> dict[st
     kill_at = start + limit + kill_slack(limit)
     spawned = time.monotonic()
     env = {k: v for k, v in os.environ.items() if k != "PYTHONSTARTUP"}
-    proc = subprocess.Popen([sys.executable, "-c", _BOOT, _ROOT, str(os.getpid())],
-                            stdin=subprocess.PIPE, stdout=subprocess.PIPE, env=env)
-    try:
+    proc = None
+    try:                           # Popen inside: a Ctrl-C just after it still ends the child
+        proc = subprocess.Popen([sys.executable, "-c", _BOOT, _ROOT, str(os.getpid())],
+                                stdin=subprocess.PIPE, stdout=subprocess.PIPE, env=env)
         out, _ = proc.communicate(payload, timeout=max(kill_at - time.monotonic(), 0.0))
     except subprocess.TimeoutExpired:
         _end(proc)
         return None
     except BaseException:          # Ctrl-C (or SIGTERM turned into it): end the child
-        _end(proc)
+        if proc is not None:
+            _end(proc)
         raise
     try:
         kind, value, ready = pickle.loads(out)
