@@ -243,7 +243,9 @@ def _machine(env: dict, opt: dict) -> list[str]:
             f"- load average at end: {_load(env['load_end'])}",
             f"- per-solve time limit {opt['time_limit']:g} s (CP-SAT: "
             f"{opt['cpsat_limit']:g} s); runs stopped by it count with the limit as their "
-            f"time; not installed / not registered: {', '.join(opt['missing']) or 'none'}",
+            f"time; not installed / not registered: {', '.join(opt['missing']) or 'none'}"
+            + ("; every back end runs in this process under its own limit "
+               "(`isolate=False`: no child process)" if opt.get("in_process") else ""),
             ""]
 
 
