@@ -170,10 +170,8 @@ def assign_with_misses(n1: int, n2: int, rows: np.ndarray, cols: np.ndarray,
         row_of_col[c] = r
         return Assignment2D(col_of_row, row_of_col, how)
     size = n1 + n2
-    n_aug = 2 * len(rows) + int(fin_r.sum()) + int(fin_c.sum())   # augmented edges
-    sparse = method == "sparse" or (method == "auto" and _prefer_sparse(size, n_aug))
     ar, ac, aw = augmented_edges(n1, n2, rows, cols, weights, row_miss, col_miss)
-    if sparse:
+    if method == "sparse" or (method == "auto" and _prefer_sparse(size, len(ar))):
         r, c = _compiled_lap(size, ar, ac, aw) if _compiled_sparse() else \
             _sparse_lap(size, size, ar, ac, aw)
         how = "sparse"

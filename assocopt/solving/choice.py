@@ -5,10 +5,13 @@ can choose per component without importing ``solve``.
 """
 from __future__ import annotations
 
+import numpy as np
+
 from ..problems.problem import AssignmentProblem
 from ..solvers.base import module_installed
 
-__all__ = ["choose_solver", "BNB_MAX_CANDIDATES", "BNB_MAX_GATED", "BNB_MAX_KEPT"]
+__all__ = ["choose_solver", "bnb_cap", "BNB_MAX_CANDIDATES", "BNB_MAX_GATED",
+           "BNB_MAX_KEPT"]
 
 
 #: ``auto`` sends N >= 3 problems with at most this many candidates to ``bnb``
@@ -39,10 +42,16 @@ def choose_solver(problem: AssignmentProblem, relax: str | None = None) -> str:
         return "highs"
     if problem.ndim == 2:
         return "scipy-lsa"
-    if problem.n_candidates <= BNB_MAX_CANDIDATES and _bnb_usable(problem) and \
-            (problem.n_candidates <= BNB_MAX_GATED or not (problem.tuples == 0).any()):
+    if problem.n_candidates <= bnb_cap((problem.tuples == 0).any()) and \
+            _bnb_usable(problem):
         return "bnb"
     return "lagrangian-exact"
+
+
+def bnb_cap(gated):
+    """The most candidates ``auto`` gives ``bnb``: :data:`BNB_MAX_GATED` for a problem
+    (or, elementwise, component) with dummies, else :data:`BNB_MAX_CANDIDATES`."""
+    return np.where(gated, BNB_MAX_GATED, BNB_MAX_CANDIDATES)
 
 
 def _bnb_usable(problem: AssignmentProblem) -> bool:

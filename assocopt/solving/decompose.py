@@ -239,8 +239,7 @@ def _solve_parts(problem: AssignmentProblem, sp: Split, todo: np.ndarray,
                  out: _Outcome) -> int:
     """Solve the components ``todo`` (none trivial); returns how many the batch
     kernel settled."""
-    from .choice import (BNB_MAX_CANDIDATES, BNB_MAX_GATED, BNB_MAX_KEPT,
-                         _numba_installed)
+    from .choice import BNB_MAX_KEPT, _numba_installed, bnb_cap
 
     T, csizes = local_tuples(problem, sp.of_row, sp.n)
     plain_auto = requested == "auto"
@@ -255,8 +254,7 @@ def _solve_parts(problem: AssignmentProblem, sp: Split, todo: np.ndarray,
         else:
             gated = np.bincount(sp.of_cand, weights=(T == 0).any(axis=1),
                                 minlength=sp.n)[todo] > 0
-            cap = np.where(gated, BNB_MAX_GATED, BNB_MAX_CANDIDATES)
-            fits = (sp.sizes[todo] <= cap) & (top2.sum(axis=1) <= BNB_MAX_KEPT)
+            fits = (sp.sizes[todo] <= bnb_cap(gated)) & (top2.sum(axis=1) <= BNB_MAX_KEPT)
         from ..solvers.bnb_batch import solve_components
         left = _left(opts, t0)()
         # bnb's own options only when bnb was asked for: with plain ``auto`` ``opts``
