@@ -2,11 +2,11 @@
 
 A Stone Soup MFA tracker (Gaussian-mixture tracks, ``MFAHypothesiser(DistanceGater(
 PDAHypothesiser(include_all=True, prob_gate=0.99), Mahalanobis(), 4))``) runs on
-targets crossing in pairs (:class:`assocopt.tracking.simulate.CrossingScenario`,
+targets crossing in pairs (:class:`assocopt.tracking.scenarios.simulate.CrossingScenario`,
 400 area units per target, P_D = 0.9, clutter n/2 a scan).  At every step:
 
 * the hypotheses are generated once, by the batched
-  :class:`~assocopt.tracking.stonesoup_hypothesiser.LinearGaussianMFAHypothesiser`
+  :class:`~assocopt.tracking.stonesoup.hypothesiser.LinearGaussianMFAHypothesiser`
   (and, in the generation rows, also by Stone Soup's chain: both timed, checked equal);
 * both associators get those same hypotheses (served from a cache) and their
   ``associate`` call is timed (the window solve with its build and pruning;
@@ -110,10 +110,10 @@ def run_config(n: int, window: int, steps: int, seed: int, repeat: int,
     from stonesoup.types.update import GaussianMixtureUpdate
     from stonesoup.updater.kalman import KalmanUpdater
 
-    from assocopt.tracking.simulate import CrossingScenario
+    from assocopt.tracking.scenarios.simulate import CrossingScenario
     from assocopt.tracking.stonesoup import AssocoptMFA, mfa_reference_cost
-    from assocopt.tracking.stonesoup_scenario import mixture_tracks, scan_detections
-    from assocopt.tracking.stonesoup_hypothesiser import LinearGaussianMFAHypothesiser
+    from assocopt.tracking.stonesoup.scenario import mixture_tracks, scan_detections
+    from assocopt.tracking.stonesoup.hypothesiser import LinearGaussianMFAHypothesiser
 
     class Cached(Hypothesiser):
         """Serves the hypotheses generated for this step."""

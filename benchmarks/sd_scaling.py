@@ -325,7 +325,7 @@ _LAP_CODE = r"""
 import json, sys, time
 import numpy as np
 from scipy.optimize import linear_sum_assignment
-from assocopt.solvers.lap import assign_with_misses, lapx_available, linear_assignment
+from assocopt.solvers.twod.lap import assign_with_misses, lapx_available, linear_assignment
 quick = sys.argv[1] == "1"
 rng = np.random.default_rng(0)
 n = 500 if quick else 2000

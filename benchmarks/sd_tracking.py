@@ -16,7 +16,7 @@ equality-constrained binary program from the same arrays and calls
 ``scipy.optimize.milp`` (``mip_rel_gap=0``: a proof, as the others give).  Fast
 solves are repeated (interleaved, the minimum kept).
 Every proven objective is checked against the others.  The tuple building time
-(pairwise gate and :func:`assocopt.tracking.sd_gating.gated_tuples`) is recorded beside.
+(pairwise gate and :func:`assocopt.tracking.gating.gated_tuples`) is recorded beside.
 The JSON holds the raw results, the environment and the load averages; the page is
 drawn from it only (``benchmarks/tracking_page.py``), and
 ``tests/test_benchmarks_tracking.py`` re-renders and checks it.

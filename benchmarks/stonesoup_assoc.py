@@ -37,7 +37,7 @@ ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))
 
 from assocopt.tracking.gating import gate  # noqa: E402
-from assocopt.tracking.simulate import CVScenario  # noqa: E402
+from assocopt.tracking.scenarios.simulate import CVScenario  # noqa: E402
 
 MISSED_DISTANCE = 3.0
 

@@ -8,7 +8,7 @@ For each back end and limit: the wall time of ``solve(problem, name, time_limit=
 (building the model included; each back end's package imported beforehand, as in a
 program that already uses it), its overshoot past ``L`` and whether it is within the
 tolerance max(1 s, 10 % of L).  HiGHS, scipy, cvxpy and OR-tools run in a child process under a
-limit (``isolate``, :mod:`assocopt.solvers.limited`); they are also run in this
+limit (``isolate``, :mod:`assocopt.solvers.milp.limited`); they are also run in this
 process (``isolate=False``) for comparison.  The start-up cost of the child (seconds
 from spawn until it has imported the solver and read the model) is measured on a
 3x3x3 problem without the spinning processes (best and median of ``--rounds``), and recorded

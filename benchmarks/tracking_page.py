@@ -172,7 +172,7 @@ def render(data: dict) -> str:
          "radii (4: well separated; below 1: closer than the gate, one dense component), "
          "P_D 0.9 (0.8 to 0.95 in the unseen settings), `clutter * n` false alarms per "
          "sensor, tuples gated pairwise at 99.9 % "
-         "(chi-square, 2 dof) and enumerated by `assocopt.tracking.sd_gating.gated_tuples`, "
+         "(chi-square, 2 dof) and enumerated by `assocopt.tracking.gating.gated_tuples`, "
          "negative log-likelihood-ratio costs.  Each method is timed from the candidate "
          "arrays on: `solve(AssignmentProblem.sparse(sizes, T, c), solver)`; "
          "`highs`, whole: the same with `decompose=False`; plain milp: the binary program "

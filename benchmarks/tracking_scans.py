@@ -11,7 +11,7 @@ distance at which two measurements of one target stop being compatible, ``gamma`
 the ``gate`` quantile of chi-square with 2 degrees of freedom.
 
 Tuples are gated pairwise (the chi-square gate of each sensor pair, a distance test
-here, by KD-trees; :func:`assocopt.tracking.sd_gating.gated_tuples` for the cliques), and each tuple
+here, by KD-trees; :func:`assocopt.tracking.gating.gated_tuples` for the cliques), and each tuple
 costs its negative log-likelihood ratio against "all its measurements are false
 alarms" (Deb et al. 1997, positions known up to the ML estimate):
 
@@ -32,8 +32,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from assocopt import AssignmentProblem
-from assocopt.tracking.gating import chi2_threshold
-from assocopt.tracking.sd_gating import gated_tuples
+from assocopt.tracking.gating import chi2_threshold, gated_tuples
 
 __all__ = ["ScanSpec", "draw_scan", "pair_gate", "gated", "nllr", "build_problem"]
 
@@ -98,7 +97,7 @@ def pair_gate(spec: ScanSpec, meas: list[np.ndarray]) -> dict[tuple[int, int], n
 
 def gated(spec: ScanSpec, meas: list[np.ndarray], ok=None) -> np.ndarray:
     """The pairwise-gated tuples (0 = dummy): :func:`pair_gate`, then the cliques
-    (:func:`assocopt.tracking.sd_gating.gated_tuples`)."""
+    (:func:`assocopt.tracking.gating.gated_tuples`)."""
     ok = pair_gate(spec, meas) if ok is None else ok
     # single-measurement tuples: a false alarm is always possible
     return gated_tuples([len(z) for z in meas], ok, np.full(spec.N, spec.pd),

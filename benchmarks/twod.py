@@ -39,8 +39,8 @@ sys.path.insert(0, str(ROOT))
 
 from assocopt import AssignmentProblem, kbest, marginals, solve  # noqa: E402
 from assocopt.workflow.generate import gated_2d  # noqa: E402
-from assocopt.solvers.bruteforce import enumerate_solutions  # noqa: E402
-from assocopt.solvers.lap import augmented_edges, augmented_matrix, lapx_available  # noqa: E402
+from assocopt.solvers.baseline.bruteforce import enumerate_solutions  # noqa: E402
+from assocopt.solvers.twod.lap import augmented_edges, augmented_matrix, lapx_available  # noqa: E402
 
 JSON = ROOT / "docs" / "benchmarks-2d.json"
 PAGE = ROOT / "docs" / "benchmarks-2d.md"
@@ -155,7 +155,7 @@ def _components(p: AssignmentProblem) -> tuple[int, int]:
     both out; isolated indices count) and the size (rows + columns) of the largest."""
     import scipy.sparse as sp
     from scipy.sparse.csgraph import connected_components
-    from assocopt.solvers.sparse2d import prune_dominated, split_candidates
+    from assocopt.solvers.twod.sparse import prune_dominated, split_candidates
 
     n1, n2 = p.sizes
     rows, cols, w, _, rm, cm, _, _ = split_candidates(p)
@@ -184,7 +184,7 @@ def _first_call(scan: str, n: int, k: float) -> dict:
 def sparse_rows(cases: list[tuple[str, int, float]], quick: bool) -> list[dict]:
     import scipy.sparse as sp
     from scipy.sparse.csgraph import min_weight_full_bipartite_matching as mwfbm
-    from assocopt.solvers.sparse2d import split_candidates
+    from assocopt.solvers.twod.sparse import split_candidates
 
     rows = []
     for scan, n, k in cases:

@@ -24,8 +24,8 @@ from conftest import sd_problems
 
 pytest.importorskip("numba", reason="the bnb back end needs numba")
 
-from assocopt.solvers import bnb  # noqa: E402
-from assocopt.solvers import bnb_kernels as kern  # noqa: E402
+from assocopt.solvers.bnb import backend as bnb  # noqa: E402
+from assocopt.solvers.bnb import kernels as kern  # noqa: E402
 
 
 @given(sd_problems())
@@ -305,7 +305,7 @@ def test_a_bnb_solve_loads_only_the_kernels_it_calls():
     root = Path(__file__).resolve().parents[1]
     code = ("import json, numpy as np\n"
             "from assocopt import AssignmentProblem, solve\n"
-            "from assocopt.solvers import bnb_kernels as k\n"
+            "from assocopt.solvers.bnb import kernels as k\n"
             "p = AssignmentProblem.dense(np.random.default_rng(1).random((4, 4, 4)))\n"
             "sol = solve(p, 'bnb')\n"
             "names = ['prepare', 'solve']\n"

@@ -201,7 +201,7 @@ def test_compare_check_flags_a_wrong_record(tmp_path, capsys):
 
 
 def test_compare_keeps_going_when_a_back_end_raises(monkeypatch, capsys):
-    from assocopt.solvers.greedy import GreedyBackend
+    from assocopt.solvers.baseline.greedy import GreedyBackend
 
     def boom(self, problem, options):
         raise RuntimeError("kaboom")

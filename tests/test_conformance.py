@@ -78,7 +78,7 @@ def test_greedy_is_feasible_and_never_below_optimum(p):
 
 
 def test_brute_force_counts_every_solution():
-    from assocopt.solvers.bruteforce import count_solutions
+    from assocopt.solvers.baseline.bruteforce import count_solutions
     assert count_solutions(AssignmentProblem.dense(np.zeros((4, 4)))) == 24
     assert count_solutions(AssignmentProblem.dense(np.zeros((3, 3, 3)))) == 36
     # 2 targets, 3 sensors with dummies allowed: every partition of the measurements

@@ -172,7 +172,7 @@ def test_infeasible_component_makes_whole_infeasible():
 @given(st.lists(blocks(3), min_size=1, max_size=5))
 def test_batch_kernel_equals_brute_force(parts):
     pytest.importorskip("numba")
-    from assocopt.solvers.bnb_batch import run_batch
+    from assocopt.solvers.bnb.batch import run_batch
     from assocopt.solvers.kernels.driver import INFEASIBLE, PROVEN
     Ts, cs, szs, kp = [], [], [], [0]
     for sizes, T, c in parts:
@@ -266,7 +266,7 @@ def test_auto_batch_runs_bnb_at_its_own_defaults(monkeypatch):
     for bnb) but whose components suit bnb: the batch gets bnb's defaults, not the
     lagrangian-exact options ``auto`` parsed for the whole (max_iter 500, step0 1, ...)."""
     pytest.importorskip("numba")
-    import assocopt.solvers.bnb_batch as bb
+    import assocopt.solvers.bnb.batch as bb
     from assocopt.solving.choice import choose_solver
     rng = np.random.default_rng(4)
     grid = np.stack(np.meshgrid(*[np.arange(3)] * 3, indexing="ij"), -1).reshape(-1, 3)[1:]

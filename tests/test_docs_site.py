@@ -165,7 +165,7 @@ def test_every_public_name_has_a_page(site):
         names = set(importlib.import_module(module).__all__) - {"__version__", "solvers"}
         assert {n for n, _ in api[module]} == names, module
     for module in ("assocopt.tracking.stonesoup", "assocopt.tracking.gating",
-                   "assocopt.tracking.costs.kinematic", "assocopt.tracking.simulate"):
+                   "assocopt.tracking.costs.kinematic", "assocopt.tracking.scenarios.simulate"):
         assert {n for n, _ in api[module]} == set(importlib.import_module(module).__all__)
     gen = site / "api" / "generated"
     missing = [m for m in api if not (gen / f"{m}.html").is_file()]

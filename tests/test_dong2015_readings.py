@@ -13,7 +13,7 @@ from assocopt.tracking.decide.topology import TopologyParams, pair_gammas, prepa
 from assocopt.tracking.scenarios.dong2015 import Dong2015, Run
 from assocopt.tracking.scenarios.dong2015_assoc import (METHODS, calibration, run_method,
                                                          slot_shares)
-from assocopt.tracking.topology import chi2_gate
+from assocopt.tracking.costs.topology import chi2_gate
 
 PINNED = {   # E_c at steps 1..6, in eighths (8 common targets)
     "tsd-rect": [5, 2, 4, 4, 3, 4],

@@ -12,7 +12,7 @@ import pytest
 from assocopt.tracking.decide.topology import TopologyParams, phi_matrix, prepare
 from assocopt.tracking.scenarios.dong2015 import Dong2015
 from assocopt.tracking.scenarios.dong2015_assoc import METHODS, run_method
-from assocopt.tracking.topology import headings
+from assocopt.tracking.costs.topology import headings
 
 
 def test_environments_geometry_and_common_observation_rate():

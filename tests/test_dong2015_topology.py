@@ -14,7 +14,7 @@ from assocopt.tracking.decide.topology import (LARGE, TopologyParams, assign_pai
                                                coarse_pregate, degree_matrix, phi_matrix,
                                                phi_reference, prepare, thresholds,
                                                trial_pairs)
-from assocopt.tracking.topology import (all_distances, chi2_gate, heading_jacobians,
+from assocopt.tracking.costs.topology import (all_distances, chi2_gate, heading_jacobians,
                                         heading_variance, headings, pair_distances,
                                         reference_frames, rotations)
 

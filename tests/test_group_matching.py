@@ -13,7 +13,7 @@ from scipy.stats import chi2
 
 from assocopt.tracking.belief import (MassFunction, conjunctive, discount, zhang_combination,
                              zhang_conflict, conflict)
-from assocopt.tracking.group_matching import (MATCH_FRAME, InvalidObservationsError, MeasureParams,
+from assocopt.tracking.belief.group_matching import (MATCH_FRAME, InvalidObservationsError, MeasureParams,
                                      Observations, Relations, attribute_conflict,
                                      combined_masses, correct_match_rate, matching_matrix,
                                      mm_ncr, mm_tbm, mm_wa, position_belief,

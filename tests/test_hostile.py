@@ -439,7 +439,7 @@ class TestTimeLimits:
     def test_cpsat_workers_recorded(self):
         if not registered()["ortools-cpsat"].is_available():
             pytest.skip("ortools not installed")
-        from assocopt.solvers.ortools_cpsat import DEFAULT_WORKERS
+        from assocopt.solvers.milp.ortools_cpsat import DEFAULT_WORKERS
 
         p = AssignmentProblem.dense(np.random.default_rng(1).integers(0, 9, (4, 4)))
         sol = solve(p, "ortools-cpsat")
@@ -726,7 +726,7 @@ class TestRankingEdgeInputs:
         """The node cap lowered to 20000 (the default 2 million costs 15 s of search
         to reach; the error path is the same)."""
         from assocopt import marginals
-        from assocopt.solvers import bruteforce
+        from assocopt.solvers.baseline import bruteforce
 
         capped = functools.partial(bruteforce.enumerate_solutions, max_nodes=20_000)
         monkeypatch.setattr(bruteforce, "enumerate_solutions", capped)
@@ -756,7 +756,7 @@ class TestRankingEdgeInputs:
         assert code == 0 and rec["exhausted"] and rec["found"] == len(rec["solutions"])
         objs = [s["objective"] for s in rec["solutions"]]
         assert objs == sorted(objs) and objs[0] == -6
-        from assocopt.solvers.bruteforce import enumerate_solutions
+        from assocopt.solvers.baseline.bruteforce import enumerate_solutions
 
         problem = read_instance(ROOT / "instances" / "example-2d-miss.json")
         assert rec["found"] == sum(1 for _ in enumerate_solutions(problem))

@@ -7,7 +7,7 @@ import pytest
 from hypothesis import given, settings, strategies as st
 
 from assocopt import AssignmentProblem, InvalidProblemError, kbest
-from assocopt.solvers.bruteforce import enumerate_solutions
+from assocopt.solvers.baseline.bruteforce import enumerate_solutions
 from assocopt.testing import problems, random_problem
 
 from test_twod import two_d_cases

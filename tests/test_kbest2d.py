@@ -11,7 +11,7 @@ from scipy.optimize import linear_sum_assignment
 
 from assocopt import AssignmentProblem, kbest
 from assocopt.ranking import kbest2d
-from assocopt.solvers.bruteforce import enumerate_solutions
+from assocopt.solvers.baseline.bruteforce import enumerate_solutions
 from assocopt.solvers.kernels.sap import augment, lap, lap_warm
 
 INF = np.inf

@@ -22,7 +22,7 @@ from assocopt import (AssignmentProblem, InvalidProblemError, SolverNotInstalled
                       Status, choose_solver, solve)
 from assocopt.solvers import lagrangian as lg
 from assocopt.solvers import registered
-from assocopt.solvers.lap import (LapInfeasibleError, assign_with_misses,
+from assocopt.solvers.twod.lap import (LapInfeasibleError, assign_with_misses,
                                   assignment_duals, lapx_available, linear_assignment)
 from assocopt.testing import assert_feasible, assert_optimal, random_problem, random_scans
 
@@ -367,7 +367,7 @@ def test_lap_option_lapx_without_the_package_names_it():
 
 
 def test_lapjv_backend_names_the_missing_package(monkeypatch):
-    from assocopt.solvers.lapjv import LapjvBackend
+    from assocopt.solvers.twod.lapjv import LapjvBackend
     monkeypatch.setattr(LapjvBackend, "module", "lap_not_installed_here")
     with pytest.raises(SolverNotInstalledError, match="lapx"):
         solve(AssignmentProblem.dense(np.ones((2, 2))), "lapjv")

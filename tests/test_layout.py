@@ -49,6 +49,23 @@ CORE: dict[str, tuple[str, ...]] = {
     "assocopt.cli": _BASE + ("assocopt.solving", "assocopt.ranking", "assocopt.io",
                              "assocopt.workflow"),
 }
+#: Inside ``assocopt.solvers``: the shared top-level modules, and the parts, each with
+#: what it may import of the package besides itself (its ``__init__`` says the same).
+SOLVERS_TOP = tuple(f"assocopt.solvers.{m}" for m in
+                    ("base", "options", "status", "scaling", "interruptible"))
+SOLVERS_PARTS: dict[str, tuple[str, ...]] = {
+    "assocopt.solvers.kernels": (),
+    "assocopt.solvers.twod": ("assocopt.solvers.base", "assocopt.solvers.scaling",
+                              "assocopt.solvers.kernels"),
+    "assocopt.solvers.milp": ("assocopt.solvers.base", "assocopt.solvers.status",
+                              "assocopt.solvers.interruptible"),
+    "assocopt.solvers.bnb": ("assocopt.solvers.base", "assocopt.solvers.interruptible",
+                             "assocopt.solvers.kernels"),
+    "assocopt.solvers.baseline": ("assocopt.solvers.base",),
+    "assocopt.solvers.lagrangian": SOLVERS_TOP + (
+        "assocopt.solvers.kernels", "assocopt.solvers.twod", "assocopt.solvers.milp",
+        "assocopt.solvers.bnb", "assocopt.solvers.baseline"),
+}
 #: The one place the core names the tracking layer: the cost builders of scenario
 #: models, looked up by name like a plug-in (assocopt/workflow/models.py, COST_LAYER).
 PLUGIN_POINTS = {"assocopt.workflow.models": {"assocopt.tracking.costs"},
@@ -230,6 +247,79 @@ def test_each_core_package_says_what_it_may_import():
             assert "nothing of assocopt" in said, part
 
 
+def _solvers_part(mod: str) -> str | None:
+    """The part of ``assocopt.solvers`` that ``mod`` belongs to, the top-level module it
+    is, or None outside the package."""
+    for part in tuple(SOLVERS_PARTS) + SOLVERS_TOP + ("assocopt.solvers",):
+        if _hits(mod, (part,)):
+            return part
+    return None
+
+
+def test_solver_parts_import_only_the_shared_modules_and_the_parts_they_name():
+    """A back end's part reads the shared top-level modules (and the kernels), not
+    another part, except where the table says so; the top-level modules import no part."""
+    bad = []
+    for name, path in _modules().items():
+        part = _solvers_part(name)
+        if part is None or part == "assocopt.solvers":
+            continue
+        allowed = (part,) + SOLVERS_PARTS.get(part, SOLVERS_TOP)
+        for line, mod in _imports(name, path):
+            other = _solvers_part(mod)
+            if other is not None and other != "assocopt.solvers" and other not in allowed:
+                bad.append(f"{path.relative_to(ROOT)}:{line} imports {mod} "
+                           f"({part} may import {', '.join(allowed[1:]) or 'nothing'})")
+    assert not bad, "imports across the parts of assocopt.solvers:\n" + "\n".join(bad)
+
+
+def test_each_solver_part_says_what_it_may_import():
+    """Each part's ``__init__`` docstring has a ``May import:`` line naming the core
+    packages that :data:`CORE` gives ``assocopt.solvers`` and, of the solvers' own
+    modules, exactly those :data:`SOLVERS_PARTS` gives the part."""
+    for part, allowed in SOLVERS_PARTS.items():
+        init = ROOT / part.replace(".", "/") / "__init__.py"
+        doc = ast.get_docstring(ast.parse(init.read_text(encoding="utf-8"))) or ""
+        assert "May import:" in doc, f"{part}: its docstring does not say what it may import"
+        said = doc.split("May import:", 1)[1].split("\n\n", 1)[0]
+        named = set(re.findall(r"assocopt\.[\w.]+\w", said)) - {"assocopt.solvers"}
+        core = {m for m in named if not m.startswith("assocopt.solvers")}
+        assert core == set(CORE["assocopt.solvers"]) or not allowed, (part, sorted(core))
+        assert named - core == set(allowed), (part, sorted(named - core), sorted(allowed))
+
+
+def _forwards_only(path: Path) -> bool:
+    """Whether a module's body is nothing but imports (and ``__all__``): a forwarding
+    shim that keeps an old path alive instead of holding code."""
+    body = ast.parse(path.read_text(encoding="utf-8")).body
+    if body and isinstance(body[0], ast.Expr) and isinstance(body[0].value, ast.Constant):
+        body = body[1:]
+    def forwarding(node: ast.stmt) -> bool:
+        if isinstance(node, (ast.Import, ast.ImportFrom)):
+            return True
+        return isinstance(node, ast.Assign) and all(
+            isinstance(t, ast.Name) and t.id == "__all__" for t in node.targets)
+    return bool(body) and all(forwarding(n) for n in body) and \
+        any(isinstance(n, ast.ImportFrom) and n.module != "__future__" for n in body)
+
+
+def test_no_forwarding_shims():
+    """Only a package's ``__init__`` re-exports; no module exists just to forward
+    names from where the code moved (import the code from where it lives)."""
+    shims = [str(p.relative_to(ROOT)) for p in _modules().values()
+             if p.name != "__init__.py" and _forwards_only(p)]
+    assert not shims, f"modules that only forward imports: {shims}"
+
+
+def test_the_shim_check_can_fail(tmp_path):
+    shim = tmp_path / "old.py"
+    shim.write_text('"""Moved."""\nfrom __future__ import annotations\n'
+                    'from .new import f, g  # noqa: F401\n__all__ = ["f", "g"]\n')
+    assert _forwards_only(shim)
+    shim.write_text("from .new import f\n\ndef g():\n    return f()\n")
+    assert not _forwards_only(shim)
+
+
 def test_no_import_cycles():
     """No group of the project's modules imports each other in a loop, counting imports
     inside functions too: each module can be read and changed with only what is below
@@ -296,8 +386,8 @@ def test_no_module_is_over_the_size_limit():
 CONCEPTS = {
     "the S-D formulation": "model/formulation.py",
     "the S-D problem": "problems/problem.py",
-    "the 2-D LAP": "solvers/lap.py",
-    "the HiGHS back end": "solvers/highs.py",
+    "the 2-D LAP": "solvers/twod/lap.py",
+    "the HiGHS back end": "solvers/milp/highs.py",
     "solve": "solving/api.py",
     "the KLD cost": "tracking/costs/kld.py",
     "the dong2015 scenario": "tracking/scenarios/dong2015.py",

@@ -1,5 +1,5 @@
 """Time limits that hold: under a limit, HiGHS, scipy's milp and cvxpy solve in a child
-process (``assocopt.solvers.limited``) that is killed at the deadline or on Ctrl-C.
+process (``assocopt.solvers.milp.limited``) that is killed at the deadline or on Ctrl-C.
 
 No wall-clock assertions: a killed child is recognised by ``info["isolated"]`` and the
 autouse fixture of conftest.py checks that no child process outlives its test.
@@ -19,7 +19,8 @@ from assocopt import AssignmentProblem, solve
 from assocopt.runtime.errors import InvalidProblemError
 from assocopt.workflow.generate import generate_dense
 from assocopt.model.solution import Status
-from assocopt.solvers import limited, registered
+from assocopt.solvers.milp import limited
+from assocopt.solvers import registered
 
 ISOLATED = [n for n in ("highs", "scipy", "cvxpy", "ortools-cpsat", "ortools-mip")
             if registered()[n].is_available()]

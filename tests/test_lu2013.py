@@ -15,7 +15,7 @@ from assocopt.reproduce import PAPERS, list_papers, reproduce
 from assocopt.reproduce import lu2013 as L
 from assocopt.solving import lp_fixing
 from assocopt.tracking.scenarios.lu2013 import PAPER_SENSORS_KM, Lu2013
-from assocopt.solvers.bruteforce import enumerate_solutions
+from assocopt.solvers.baseline.bruteforce import enumerate_solutions
 from conftest import rerun_committed
 
 

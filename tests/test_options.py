@@ -162,7 +162,7 @@ def test_settle_optimal_is_the_one_rule(status, gap, mip_gap, claim_tol, expecte
 
 
 def test_backends_map_statuses_through_tables():
-    from assocopt.solvers import cvxpy_backend, highs, ortools_cpsat, ortools_mip, scipy_milp
+    from assocopt.solvers.milp import cvxpy_backend, highs, ortools_cpsat, ortools_mip, scipy_milp
 
     for module in (highs, scipy_milp, ortools_cpsat, ortools_mip, cvxpy_backend):
         table = module._STATUS_TABLE

@@ -19,7 +19,7 @@ from hypothesis import given, settings, strategies as st
 from assocopt import AssignmentProblem, Status, solve
 from assocopt.solvers import registered
 from assocopt.solvers.scaling import SCALE_ABOVE
-from assocopt.solvers.bruteforce import enumerate_solutions
+from assocopt.solvers.baseline.bruteforce import enumerate_solutions
 
 EXACT = sorted(n for n, c in registered().items()
                if c.exact and c.integer and c.is_available()

@@ -16,7 +16,7 @@ from assocopt.tracking.costs.kld import (kld_exact, kld_gauss, kld_printed, skld
 from assocopt.tracking.costs.pattipati import measurement_constant
 from assocopt.tracking.localisation import angles, localise, pseudo_measurements, wrap_angle
 from assocopt.tracking.scenarios.lu2013 import Lu2013
-from assocopt.solvers.bruteforce import count_solutions
+from assocopt.solvers.baseline.bruteforce import count_solutions
 
 S = np.array([[0.0, 20.0, 0.0], [20.0, 0.0, 0.0], [0.0, 0.0, 0.0]])
 

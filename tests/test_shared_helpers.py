@@ -140,7 +140,7 @@ def test_no_other_figure_writer_in_the_reproductions():
 
 def test_finite_floats_names_the_input_and_raises_the_callers_error():
     from assocopt.runtime.errors import InvalidProblemError
-    from assocopt.tracking.group_matching import InvalidObservationsError, Observations
+    from assocopt.tracking.belief.group_matching import InvalidObservationsError, Observations
     from assocopt.tracking.gating import gate
     from assocopt.problems.validation import finite_floats
     out = finite_floats([[1, 2]], "x")

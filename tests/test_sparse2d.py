@@ -9,9 +9,9 @@ from hypothesis import given, settings, strategies as st
 from scipy.optimize import linear_sum_assignment
 
 from assocopt import AssignmentProblem, Status, solve
-from assocopt.solvers import sparse2d
-from assocopt.solvers.lap import LapInfeasibleError
-from assocopt.solvers.sparse2d import assign_sparse_edges
+from assocopt.solvers.twod import sparse as sparse2d
+from assocopt.solvers.twod.lap import LapInfeasibleError
+from assocopt.solvers.twod.sparse import assign_sparse_edges
 from conftest import draw_misses
 
 
@@ -135,7 +135,7 @@ def test_kernel_matches_dense_scipy(nr, nc, seed, density):
 def _mwfbm_objective(p: AssignmentProblem) -> float:
     import scipy.sparse as sp
     from scipy.sparse.csgraph import min_weight_full_bipartite_matching
-    from assocopt.solvers.lap import augmented_edges
+    from assocopt.solvers.twod.lap import augmented_edges
 
     n1, n2 = p.sizes
     rows, cols, w, _, rm, cm, _, _ = sparse2d.split_candidates(p)

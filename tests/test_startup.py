@@ -34,7 +34,7 @@ def test_import_assocopt_loads_no_heavy_package():
     assert _heavy(mods) == []
     from assocopt.solvers import BACKEND_MODULES
     assert not {f"assocopt.solvers.{m}" for m in BACKEND_MODULES.values()} & mods
-    assert "assocopt.solvers.bnb_kernels" not in mods
+    assert "assocopt.solvers.bnb.kernels" not in mods
 
 
 def test_listing_back_ends_imports_none_of_their_packages():
@@ -58,16 +58,17 @@ def test_2d_solve_loads_only_its_back_end():
     backends = {f"assocopt.solvers.{m}" for m in BACKEND_MODULES.values()}
     # lap.py holds the LAP engine the dense 2-D path shares with `lapjv` (numpy only;
     # lapx itself is imported only when that engine is chosen)
-    assert backends & mods <= {"assocopt.solvers.scipy_lsa", "assocopt.solvers.lap"}
-    assert "assocopt.solvers.scipy_lsa" in mods and "lap" not in mods
+    assert backends & mods <= {"assocopt.solvers.twod.scipy_lsa",
+                               "assocopt.solvers.twod.lap"}
+    assert "assocopt.solvers.twod.scipy_lsa" in mods and "lap" not in mods
 
 
 @pytest.mark.skipif(importlib.util.find_spec("numba") is None, reason="needs numba")
 def test_bnb_solve_loads_numba_but_not_the_other_back_ends():
     mods = _loaded("from assocopt.cli import main\n"
                    "assert main(['solve', 'instances/sd-bearing-3s.json']) == 0")
-    assert "numba" in mods and "assocopt.solvers.bnb_kernels" in mods
-    for other in ("highspy", "ortools", "cvxpy", "assocopt.solvers.highs",
+    assert "numba" in mods and "assocopt.solvers.bnb.kernels" in mods
+    for other in ("highspy", "ortools", "cvxpy", "assocopt.solvers.milp.highs",
                   "assocopt.solvers.lagrangian"):
         assert other not in mods, other
 
@@ -77,7 +78,7 @@ def test_tiny_sd_solve_from_the_cli_loads_no_compiled_kernels(capsys):
     mods = _loaded("from assocopt.cli import main\n"
                    "assert main(['solve', 'instances/example-sd.json']) == 0")
     assert _heavy(mods) == []
-    assert "assocopt.solvers.bruteforce" in mods
+    assert "assocopt.solvers.baseline.bruteforce" in mods
 
 
 def test_one_shot_answer_equals_auto_in_the_library(capsys):
@@ -114,10 +115,12 @@ def test_one_shot_falls_back_when_enumeration_is_too_long(capsys, monkeypatch):
 
 
 def test_solvers_are_reachable_as_attributes():
-    """``assocopt.solvers.bnb`` and friends still work as attribute paths."""
+    """The parts of ``assocopt.solvers`` (``s.milp``, ``s.bnb``, ...) work as attribute
+    paths, imported on first access."""
     import assocopt.solvers as s
-    assert s.bnb.BranchBoundBackend.name == "bnb"
-    assert s.get_backend("scipy-lsa").__module__ == "assocopt.solvers.scipy_lsa"
+    assert s.milp.__name__ == "assocopt.solvers.milp" and s.twod.__doc__
+    assert s.get_backend("bnb").__module__ == "assocopt.solvers.bnb.backend"
+    assert s.get_backend("scipy-lsa").__module__ == "assocopt.solvers.twod.scipy_lsa"
     with pytest.raises(AttributeError):
         s.no_such_module  # noqa: B018
     from assocopt import UnknownSolverError

@@ -11,9 +11,9 @@ from assocopt import solve
 from assocopt.tracking.costs import kld as dv
 from assocopt.tracking.costs.sd_builder import Scan, build_costs, build_problem, tuple_geometry
 from assocopt.runtime.errors import InvalidProblemError
-from assocopt.tracking.azimuth import (azimuth_pseudo_measurements, azimuths,
+from assocopt.tracking.localisation.azimuth import (azimuth_pseudo_measurements, azimuths,
                                        localise_azimuths)
-from assocopt.tracking.sd_gating import build_gated_problem
+from assocopt.tracking.gating import build_gated_problem
 
 SENSORS = np.array([[0.0, 0.0], [30.0, 0.0], [15.0, -25.0]])
 

@@ -193,3 +193,12 @@ def test_the_core_never_imports_tracking():
             "assocopt.io, assocopt.cli; "
             "print(any(m.startswith('assocopt.tracking') for m in sys.modules))")
     assert fresh_python(code).strip() == "False"
+
+
+def test_the_gating_package_loads_neither_stonesoup_nor_numba():
+    """``assocopt.tracking.gating`` is a package of plain numpy modules: its public
+    names are there without Stone Soup or the compiled kernels."""
+    code = ("import sys\nfrom assocopt.tracking.gating import gate, gated_tuples, "
+            "build_gated_problem\n"
+            "print(sorted(m for m in ('stonesoup', 'numba') if m in sys.modules))")
+    assert fresh_python(code).strip() == "[]"

@@ -12,7 +12,7 @@ from assocopt.tracking.costs.sd_builder import candidate_tuples, tuple_costs, tu
 from assocopt.runtime.errors import InvalidProblemError
 from assocopt.tracking.localisation import angles
 from assocopt.tracking.scenarios.lu2013 import Lu2013
-from assocopt.tracking.sd_gating import bearing_pair_gate, build_gated_problem, gated_tuples
+from assocopt.tracking.gating import bearing_pair_gate, build_gated_problem, gated_tuples
 
 FIVE = ((0.0, 20.0, 0.0), (20.0, 0.0, 0.0), (0.0, 0.0, 0.0), (-20.0, 0.0, 0.0),
         (0.0, -20.0, 0.0))

@@ -22,9 +22,9 @@ from stonesoup.types.state import GaussianState  # noqa: E402
 from stonesoup.types.track import Track  # noqa: E402
 from stonesoup.updater.kalman import KalmanUpdater  # noqa: E402
 
-from assocopt.tracking.simulate import CVScenario  # noqa: E402
+from assocopt.tracking.scenarios.simulate import CVScenario  # noqa: E402
 from assocopt.tracking.stonesoup import (AssocoptGNN, AssocoptKBest,  # noqa: E402
-                                         hypotheses_problem)
+                                        hypotheses_problem)
 from conftest import fresh_python  # noqa: E402
 
 START = datetime(2026, 1, 1)
@@ -118,7 +118,8 @@ def test_problem_from_hypotheses_has_the_miss_candidates():
         assert (j == 0) == (not h)
 
 
-@pytest.mark.parametrize("module", ["stonesoup", "stonesoup_hypothesiser"])
+@pytest.mark.parametrize("module", ["stonesoup", "stonesoup.associators",
+                                    "stonesoup.hypothesiser", "stonesoup.scenario"])
 def test_missing_stonesoup_names_the_extra(module):
     code = ("import sys; sys.modules['stonesoup'] = None\n"
             f"try:\n    import assocopt.tracking.{module}\n"
@@ -128,10 +129,11 @@ def test_missing_stonesoup_names_the_extra(module):
 
 def test_importing_tracking_does_not_import_stonesoup():
     code = ("import sys, assocopt.tracking, assocopt.tracking.gating, "
-            "assocopt.tracking.costs.kinematic, assocopt.tracking.sd_gating, "
-            "assocopt.tracking.mfa, assocopt.tracking.simulate; "
+            "assocopt.tracking.costs.kinematic, assocopt.tracking.gating.tuples, "
+            "assocopt.tracking.mfa, assocopt.tracking.scenarios.simulate; "
             "print('stonesoup' in sys.modules)")
     assert fresh_python(code).strip() == "False"
+
 
 
 @pytest.mark.parametrize("k", [1, 4, 50])
@@ -165,7 +167,7 @@ def test_every_data_associator_returns_a_mapping_and_the_ranker_is_not_one():
     the k-best ranking, which returns a list, has its own interface."""
     from stonesoup.dataassociator.base import DataAssociator
     from stonesoup.tracker.simple import MultiTargetTracker
-    from assocopt.tracking import stonesoup as mod
+    from assocopt.tracking.stonesoup import associators as mod
 
     assert not issubclass(AssocoptKBest, DataAssociator)
     assert not hasattr(AssocoptKBest, "associate")

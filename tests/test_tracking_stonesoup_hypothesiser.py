@@ -23,10 +23,10 @@ from stonesoup.types.detection import Detection  # noqa: E402
 from stonesoup.types.update import GaussianMixtureUpdate  # noqa: E402
 from stonesoup.updater.kalman import KalmanUpdater  # noqa: E402
 
-from assocopt.tracking.simulate import CrossingScenario  # noqa: E402
+from assocopt.tracking.scenarios.simulate import CrossingScenario  # noqa: E402
 from assocopt.tracking.stonesoup import AssocoptMFA  # noqa: E402
-from assocopt.tracking.stonesoup_hypothesiser import LinearGaussianMFAHypothesiser  # noqa: E402
-from assocopt.tracking.stonesoup_scenario import mixture_tracks, scan_detections  # noqa: E402
+from assocopt.tracking.stonesoup.hypothesiser import LinearGaussianMFAHypothesiser  # noqa: E402
+from assocopt.tracking.stonesoup.scenario import mixture_tracks, scan_detections  # noqa: E402
 
 START = datetime(2026, 1, 1)
 

@@ -7,8 +7,8 @@ import pytest
 from hypothesis import given, settings, strategies as st
 
 from assocopt import AssignmentProblem, Status, solve
-from assocopt.solvers.lap import lapx_available
-from assocopt.solvers.sparse2d import assign_sparse
+from assocopt.solvers.twod.lap import lapx_available
+from assocopt.solvers.twod.sparse import assign_sparse
 from conftest import draw_misses
 
 ENGINES = ["scipy-lsa"] + (["lapjv"] if lapx_available() else [])
@@ -53,7 +53,7 @@ def test_dense_path_matches_brute_force(case):
 @settings(max_examples=150, deadline=None)
 @given(two_d_cases())
 def test_sparse_engine_matches_brute_force(case):
-    from assocopt.solvers.lap import LapInfeasibleError
+    from assocopt.solvers.twod.lap import LapInfeasibleError
 
     C, rm, cm = case
     p = AssignmentProblem.two_d(C, rm, cm)

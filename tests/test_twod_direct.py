@@ -1,7 +1,7 @@
 """The direct route of dense 2-D problems gives the general route's Solution.
 
 :func:`assocopt.solve` answers dense 2-D problems with default options through
-:mod:`assocopt.solvers.direct2d`; here every field of its Solution is compared with the
+:mod:`assocopt.solvers.twod.direct`; here every field of its Solution is compared with the
 general route's (forced by switching the direct route off) on random problems:
 rectangular, with and without misses, forbidden entries and misses, maximisation,
 integer costs with many ties, and infeasible ones (which the direct route hands back).
@@ -17,7 +17,7 @@ from hypothesis import HealthCheck, given, settings, strategies as st
 
 from assocopt import AssignmentProblem, Status, solve
 from assocopt.solving import api
-from assocopt.solvers import direct2d
+from assocopt.solvers.twod import direct as direct2d
 from assocopt.problems.values import _as_matrix
 
 

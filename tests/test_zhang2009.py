@@ -11,7 +11,7 @@ import pytest
 from assocopt.tracking.belief import MassFunction, pignistic
 from assocopt.tracking.decide import (TruncationOptions, gate_threshold, md_2da, md_2da_problem,
                                       md_nd)
-from assocopt.tracking.group_matching import MeasureParams, matching_matrix
+from assocopt.tracking.belief.group_matching import MeasureParams, matching_matrix
 from assocopt.tracking.scenarios.zhang2009 import Zhang2009, confusion_sets, mean_nearest_distance
 
 from conftest import EXACT, installed, rerun_committed
@@ -192,7 +192,7 @@ def test_every_observation_in_exactly_one_relation_on_random_scenarios(measure):
 
 
 def test_low_noise_full_detection_is_mostly_correct():
-    from assocopt.tracking.group_matching import correct_match_rate
+    from assocopt.tracking.belief.group_matching import correct_match_rate
     rng = np.random.default_rng(17)
     sc = Zhang2009(f=0.02, p_d=1.0)
     rates = []

@@ -63,7 +63,7 @@ def _compile_note(problem: Any, solver: str, relax: str | None, err: TextIO) -> 
     name = choose_solver(problem, relax) if solver == "auto" else solver
     if relax is not None or name != "bnb" or not get_backend("bnb").is_available():
         return False
-    from ..solvers import bnb_kernels
+    from ..solvers.bnb import kernels as bnb_kernels
     if bnb_kernels.cached():
         return False
     print("assocopt: compiling the numba kernels (first run only, about 15-30 s; "
@@ -77,7 +77,7 @@ def _kbest_note(problem: Any, solver: str, err: TextIO) -> bool:
 
     if problem.ndim != 2 or solver not in ("auto", kbest2d.NAME) or not kbest2d.available():
         return False
-    from ..solvers import bnb_kernels
+    from ..solvers.bnb import kernels as bnb_kernels
     from ..solvers.kernels.murty2d import murty
     if bnb_kernels.cached(murty):
         return False

@@ -54,7 +54,7 @@ def export_model(problem: AssignmentProblem, path: str | os.PathLike[str], *,
     import highspy
 
     from ..model.formulation import build_model
-    from ..solvers.highs import highs_from_model
+    from ..solvers.milp.highs import highs_from_model
 
     path = Path(path)
     fmt = _model_format(path)

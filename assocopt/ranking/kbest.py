@@ -23,7 +23,7 @@ The generic path below serves S-D problems, named 2-D solvers (``"scipy-lsa"``,
 ``"lapjv"``), 2-D problems when numba is missing and larger ones: children are put on the heap
 *unsolved*, with their parent's objective as a lower bound, and solved only when they
 reach the top; a 2-D problem's subproblems are solved on its dense matrix with
-forbidden entries set to ``inf`` (the dense engine of :mod:`assocopt.solvers.dense2d`),
+forbidden entries set to ``inf`` (the dense engine of :mod:`assocopt.solvers.twod.dense`),
 without warm starts (scipy and lapx expose no duals).  Ties are broken
 deterministically: equal objectives come out in the order of their candidate positions
 where the subproblems' optima allow it.  An infeasible subproblem is dropped.  When
@@ -213,8 +213,8 @@ class _Dense2DSpace(_Space):
             self.slack = bool(problem.slack.any())
 
     def solve(self, forced: tuple, banned: tuple) -> tuple | None:
-        from ..solvers.dense2d import assign_dense
-        from ..solvers.lap import LapInfeasibleError
+        from ..solvers.twod.dense import assign_dense
+        from ..solvers.twod.lap import LapInfeasibleError
 
         C, rm, cm = self.C.copy(), self.rm.copy(), self.cm.copy()
         for i, j in banned:
@@ -245,7 +245,7 @@ class _Dense2DSpace(_Space):
         return self.problem.objective_of(sel), sel, items
 
     def _positions(self, cor: np.ndarray) -> tuple[np.ndarray, list]:
-        from ..solvers.dense2d import _answer_positions
+        from ..solvers.twod.dense import _answer_positions
 
         d = self.problem.dense_view
         if d is not None:

@@ -195,7 +195,7 @@ def _solutions_dense(problem: AssignmentProblem, cor: np.ndarray) -> list[Soluti
 
 def _solutions_list(problem: AssignmentProblem, cor: np.ndarray) -> list[Solution]:
     """The answers of a problem given as a candidate list (positions looked up)."""
-    from ..solvers.dense2d import _answer_positions
+    from ..solvers.twod.dense import _answer_positions
 
     out = []
     for c in cor:

@@ -85,7 +85,7 @@ def marginals(problem: AssignmentProblem, k: int = 100, temperature: float = 1.0
         exhaustive = ranked.exhausted
     else:
         from ..runtime.errors import ProblemTooLargeError
-        from ..solvers.bruteforce import enumerate_solutions
+        from ..solvers.baseline.bruteforce import enumerate_solutions
 
         try:
             sels = list(enumerate_solutions(problem))

@@ -122,11 +122,11 @@ _DIRECT = None
 
 
 def _direct_path():
-    """:func:`assocopt.solvers.direct2d.solve_direct`, imported on first use (it loads
+    """:func:`assocopt.solvers.twod.direct.solve_direct`, imported on first use (it loads
     scipy, which ``import assocopt`` does not)."""
     global _DIRECT
     if _DIRECT is None:
-        from ..solvers.direct2d import solve_direct
+        from ..solvers.twod.direct import solve_direct
         _DIRECT = solve_direct
     return _DIRECT
 

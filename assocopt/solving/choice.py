@@ -55,7 +55,7 @@ def bnb_cap(gated):
 
 
 def _bnb_usable(problem: AssignmentProblem) -> bool:
-    from ..solvers.bnb import kept_sizes
+    from ..solvers.bnb.backend import kept_sizes
     return _numba_installed() and sum(kept_sizes(problem)) <= BNB_MAX_KEPT
 
 

@@ -248,14 +248,14 @@ def _solve_parts(problem: AssignmentProblem, sp: Split, todo: np.ndarray,
     if (plain_auto or name == "bnb") and _numba_installed():
         top2 = np.sort(csizes[todo], axis=1)[:, -2:]
         if name == "bnb":         # bnb asked for: all that its kernels take
-            from ..solvers.bnb import MAX_DENSE, MAX_KEPT
+            from ..solvers.bnb.backend import MAX_DENSE, MAX_KEPT
             fits = (top2.sum(axis=1) <= MAX_KEPT) & \
                 ((top2[:, 0] + 1) * (top2[:, 1] + 1) <= MAX_DENSE)
         else:
             gated = np.bincount(sp.of_cand, weights=(T == 0).any(axis=1),
                                 minlength=sp.n)[todo] > 0
             fits = (sp.sizes[todo] <= bnb_cap(gated)) & (top2.sum(axis=1) <= BNB_MAX_KEPT)
-        from ..solvers.bnb_batch import solve_components
+        from ..solvers.bnb.batch import solve_components
         left = _left(opts, t0)()
         # bnb's own options only when bnb was asked for: with plain ``auto`` ``opts``
         # holds the whole problem's choice's (lagrangian-exact's max_iter, step0, ...)

@@ -29,7 +29,7 @@ from .api import solve
 from ..model.formulation import build_model
 from ..problems.problem import AssignmentProblem
 from ..model.solution import Solution, Status
-from ..solvers.greedy import take_in_order
+from ..solvers.baseline.greedy import take_in_order
 
 __all__ = ["LPResult", "lp_relaxation", "lp_relaxations", "solve_with_fixing", "greedy_cover",
            "reduced_costs"]
@@ -83,7 +83,7 @@ def lp_relaxations(problems: list[AssignmentProblem]) -> list[LPResult | None]:
     candidate tuples (same constraints, other costs) reuse one HiGHS model: only the
     costs change and the simplex starts from the previous optimal basis."""
     from ..solvers.base import SolveOptions
-    from ..solvers.highs import highs_from_model
+    from ..solvers.milp.highs import highs_from_model
 
     out: list[LPResult | None] = []
     h, prev = None, None

@@ -7,7 +7,7 @@ it takes any Stone Soup hypothesiser, builds the assignment problem of each scan
 its hypotheses (missed-detection hypotheses become the miss costs) and solves it with
 the assocopt back end you name.  Five targets with nearly constant velocity, a position
 sensor with detection probability 0.9 and clutter, simulated by
-:class:`~assocopt.tracking.simulate.CVScenario`.
+:class:`~assocopt.tracking.scenarios.simulate.CVScenario`.
 """
 
 from datetime import datetime, timedelta
@@ -25,7 +25,7 @@ from stonesoup.types.state import GaussianState
 from stonesoup.types.track import Track
 from stonesoup.updater.kalman import KalmanUpdater
 
-from assocopt.tracking.simulate import CVScenario
+from assocopt.tracking.scenarios.simulate import CVScenario
 from assocopt.tracking.stonesoup import AssocoptGNN, AssocoptKBest
 
 sc = CVScenario(n_targets=5, n_steps=25, q=0.01, pd=0.9, clutter_rate=8.0,

@@ -23,7 +23,7 @@ from ...tracking.decide.topology import (TopologyParams, phi_matrix, phi_referen
                                          prepare)
 from ...tracking.scenarios.dong2015 import OURS as SCENARIO_OURS, Dong2015
 from ...tracking.scenarios.dong2015_assoc import METHODS, run_method
-from ...tracking.topology import chi2_gate
+from ...tracking.costs.topology import chi2_gate
 
 __all__ = ["DEFAULTS", "PAPER", "LABELS", "LAP_READINGS", "experiments", "trial",
            "parameters", "lap_paths"]

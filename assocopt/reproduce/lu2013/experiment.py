@@ -18,7 +18,7 @@ from ...experiments import Experiment, association_metrics
 from ...tracking.scenarios.lu2013 import PAPER, REPRODUCTION_REGION_KM, Lu2013
 from ...problems.problem import AssignmentProblem
 from ...model.solution import Status
-from ...solvers.bruteforce import enumerate_solutions
+from ...solvers.baseline.bruteforce import enumerate_solutions
 from ...solving import lp_fixing
 
 __all__ = ["METHODS", "PAPER_TABLES", "PAPER_FIG2_GAIN", "DEFAULTS", "experiments",

@@ -17,7 +17,7 @@ Four experiments, each with its own results store ``OUT/zhang2009-*.sqlite``:
                  pi = 0) at three noise levels.
 
 Every method of a trial decides on the same simulated run (paired comparison).
-The metric is :func:`~assocopt.tracking.group_matching.correct_match_rate` (P_c: correct relations / true relations per run, averaged)
+The metric is :func:`~assocopt.tracking.belief.group_matching.correct_match_rate` (P_c: correct relations / true relations per run, averaged)
 and ``all_correct`` (the run's relations entirely right); timings are volatile
 metrics (seconds per decision, the matching measures excluded).
 """

@@ -18,7 +18,7 @@ from ...problems.problem import AssignmentProblem
 from ...model.solution import Status
 from ...tracking.decide.md2da import gate_threshold, md_2da, md_2da_problem
 from ...tracking.decide.truncation import TruncationOptions, md_nd
-from ...tracking.group_matching import (MeasureParams, Relations, correct_match_rate,
+from ...tracking.belief.group_matching import (MeasureParams, Relations, correct_match_rate,
                                         matching_matrix, pair_components)
 from ...tracking.scenarios.zhang2009 import OURS, PAPER, Zhang2009
 

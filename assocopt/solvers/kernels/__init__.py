@@ -1,11 +1,11 @@
 """numba kernels of the ``bnb`` back end (its N = 3 recovery on gated problems:
 :mod:`.recovery`), the compiled window search of ``lagrangian-exact``, the dominance
 rule of both Lagrangian back ends (:mod:`.dominance`), the sparse 2-D LAP
-(:mod:`.sparse_lap`, imported by :mod:`assocopt.solvers.sparse2d`) and the 2-D ranking
+(:mod:`.sparse_lap`, imported by :mod:`assocopt.solvers.twod.sparse`) and the 2-D ranking
 of :func:`assocopt.kbest` (:mod:`.sap`: a warm-startable shortest-augmenting-path LAP
 on dense matrices, :mod:`.murty2d`: Murty's method on it, imported by
 :mod:`assocopt.ranking.kbest2d`); imported only when one of them runs (importing numba
-costs half a second). :mod:`assocopt.solvers.bnb_kernels` is the import point of the
+costs half a second). :mod:`assocopt.solvers.bnb.kernels` is the import point of the
 ``bnb`` kernels.
 
 numba's disk cache does not notice a change in a kernel another file calls: after
@@ -15,6 +15,9 @@ editing ``sap.py``, delete ``__pycache__/murty2d.*.nb[ic]`` (the same holds for
 This package file itself imports no numba: it holds the clock of compilation and
 cache loading (:func:`ensure`, :func:`spent`), which :func:`assocopt.solve` reads
 without loading the kernels.
+
+May import: nothing of assocopt (numba and numpy only): every part of
+:mod:`assocopt.solvers` may call a kernel, so the kernels call none of them.
 """
 
 from __future__ import annotations

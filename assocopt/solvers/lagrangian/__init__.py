@@ -13,7 +13,7 @@ of least reduced cost matters, ``(i, 0)`` and ``(0, j)`` pairs are the miss cost
 candidates with a dummy on both kept axes are unconstrained (taken when their reduced
 cost is negative).  ``L(u)`` is a valid lower bound for *every* ``u``; its maximum is
 the LP bound.  Each iteration costs one pass over the candidates and one 2-D
-assignment (:mod:`assocopt.solvers.lap`).
+assignment (:mod:`assocopt.solvers.twod.lap`).
 
 Multipliers follow a Polyak subgradient step towards the best feasible objective
 (momentum-deflected, scale halved when the bound stalls), started from each index's
@@ -75,6 +75,15 @@ Modules
 :mod:`.reduction` (the dominance rule :func:`dominated`), :mod:`.ascent` (solve
 state and the subgradient ascent), :mod:`.window` (exact search, CP-SAT and HiGHS on
 candidate windows), :mod:`.backend` (the two registered back ends).
+
+May import: :mod:`assocopt.runtime`, :mod:`assocopt.problems`, :mod:`assocopt.model`;
+in :mod:`assocopt.solvers` the top-level modules (:mod:`assocopt.solvers.base`,
+:mod:`assocopt.solvers.options`, :mod:`assocopt.solvers.status`,
+:mod:`assocopt.solvers.scaling`, :mod:`assocopt.solvers.interruptible`), the kernels
+(:mod:`assocopt.solvers.kernels`) and the parts it builds on: the 2-D engines
+(:mod:`assocopt.solvers.twod`), HiGHS for windows (:mod:`assocopt.solvers.milp`), the
+``bnb`` kernels (:mod:`assocopt.solvers.bnb`) and ``greedy``
+(:mod:`assocopt.solvers.baseline`).
 
 Examples
 --------

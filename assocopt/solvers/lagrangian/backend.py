@@ -18,7 +18,7 @@ from ...problems.problem import AssignmentProblem
 from ...model.solution import Status
 from ..base import Backend, RawResult, SolveOptions, register
 from ..kernels import spent
-from ..lap import LapInfeasibleError
+from ..twod.lap import LapInfeasibleError
 from .ascent import _State, _ascent
 from .local_search import _LocalSearch
 from .options import OPTIONS, OPTIONS_EXACT, check_engines
@@ -107,7 +107,7 @@ class _LagrangianBase(Backend):
 
         if st.incumbent is None and problem.n_candidates <= 200_000 and \
                 (deadline is None or time.perf_counter() < deadline):
-            from ..greedy import greedy_select
+            from ..baseline.greedy import greedy_select
             sel, covered = greedy_select(problem)
             if covered.all():
                 st.offer(sel)

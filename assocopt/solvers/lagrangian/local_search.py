@@ -12,7 +12,7 @@ import math
 import numpy as np
 
 from ...problems.problem import OPT_TOL
-from ..lap import LapInfeasibleError, assign_with_misses
+from ..twod.lap import LapInfeasibleError, assign_with_misses
 
 
 class _LocalSearch:

@@ -13,7 +13,7 @@ from typing import Any
 
 from ...runtime.errors import SolverNotInstalledError
 from ...problems.problem import OPT_TOL, kept_axes
-from ..lap import LAP_METHODS, lapx_available
+from ..twod.lap import LAP_METHODS, lapx_available
 from ..options import Option
 
 __all__ = ["OPT_TOL", "OPTIONS", "OPTIONS_EXACT", "check_engines"]

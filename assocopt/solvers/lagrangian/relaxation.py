@@ -15,7 +15,7 @@ import numpy as np
 
 from ...runtime.errors import InvalidProblemError
 from ...problems.problem import AssignmentProblem
-from ..lap import (Assignment2D, LapInfeasibleError, assign_with_misses, assignment_duals,
+from ..twod.lap import (Assignment2D, LapInfeasibleError, assign_with_misses, assignment_duals,
                    linear_assignment)
 
 

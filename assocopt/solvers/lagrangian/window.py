@@ -90,7 +90,7 @@ def _compiled_search(problem: AssignmentProblem, pos: np.ndarray, red: np.ndarra
                      ) -> tuple[np.ndarray | None, bool]:
     """:func:`_cover_search` compiled (the ``bnb`` kernels' depth-first search):
     same contract, about a hundred times faster per node."""
-    from .. import bnb_kernels as kern
+    from ..bnb import kernels as kern
 
     T = problem.tuples[pos]
     c = np.ascontiguousarray(problem.costs[pos], np.float64)
@@ -218,7 +218,7 @@ def _ilp(problem: AssignmentProblem, pos: np.ndarray, st: _State, options: Solve
     import highspy
 
     from ...model.formulation import LinearModel
-    from ..highs import highs_from_model, run_highs
+    from ..milp.highs import highs_from_model, run_highs
 
     K = len(pos)
     model = LinearModel(c=problem.costs[pos].astype(np.float64), A=_coverage(problem, pos),
@@ -280,7 +280,7 @@ def _cpsat(problem: AssignmentProblem, pos: np.ndarray, st: _State, options: Sol
     solver.parameters.log_search_progress = bool(options.verbose)
     if deadline is not None:
         solver.parameters.max_time_in_seconds = max(deadline - time.perf_counter(), 1e-3)
-    solver.parameters.catch_sigint_signal = False     # see solvers.ortools_cpsat
+    solver.parameters.catch_sigint_signal = False     # see solvers.milp.ortools_cpsat
     from ..interruptible import run_cancellable
     code, _ = run_cancellable(solver.Solve, (m,), solver.stop_search)    # Ctrl-C at once
     z = None

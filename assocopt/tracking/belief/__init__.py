@@ -14,7 +14,7 @@ Two layers:
   element names.
 * ``*_vectors`` / ``*_matrix`` functions -- the same operations on stacked mass
   vectors ``(..., 2**n)`` (numpy broadcasting), used to compute matching measures
-  for every observation pair in bulk (:mod:`assocopt.tracking.group_matching`).
+  for every observation pair in bulk (:mod:`assocopt.tracking.belief.group_matching`).
 
 Rules (paper 000, docs/papers/zhang2009.md):
 

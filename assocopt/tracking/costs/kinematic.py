@@ -41,7 +41,7 @@ from numpy.typing import ArrayLike
 
 from ...runtime.errors import InvalidProblemError
 from ...problems.problem import AssignmentProblem
-from ..gating import Gate, gate as make_gate
+from ..gating.chi2 import Gate, gate as make_gate
 
 __all__ = ["COSTS", "mahalanobis_costs", "nllr_costs", "nllr_miss_cost", "gated_problem",
            "build_problem"]

@@ -216,7 +216,7 @@ def tuple_geometry(scan: Scan, tuples: np.ndarray | None = None, *, localiser: s
     R = np.stack([np.concatenate([np.eye(w)[None], scan.R[s]])[T[:, s]]
                   for s in range(N)], axis=1).reshape(K, N, w, w)
     if scan.planar:
-        from ..azimuth import planar_tuple_geometry
+        from ..localisation.azimuth import planar_tuple_geometry
         x, P, valid, pm_mean, pm_cov = planar_tuple_geometry(scan, T, localiser, covariance)
         return TupleGeometry(T, mask, meas, R, x, P, valid, pm_mean, pm_cov,
                              {"localiser": localiser, "covariance": covariance})

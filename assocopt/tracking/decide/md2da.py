@@ -47,7 +47,7 @@ import numpy as np
 from numpy.typing import ArrayLike
 
 from ...solving.api import solve
-from ..group_matching import MeasureParams, Relations, pair_measure
+from ..belief.group_matching import MeasureParams, Relations, pair_measure
 from ...problems.problem import AssignmentProblem
 from ...model.solution import Solution, Status
 from .truncation import check_pi

@@ -2,7 +2,7 @@
 association degree lambda_uv, the degree matrix Phi and the trial pairs (Dong 2015).
 
 For every reference pair (u, v) of sensor-1 track u and sensor-2 track v, every
-neighbour is described in u's (resp. v's) frame (:mod:`assocopt.tracking.topology`),
+neighbour is described in u's (resp. v's) frame (:mod:`assocopt.tracking.costs.topology`),
 the distances gamma_ij(u, v) form an ``n1 x n2`` matrix, its 2-D assignment picks
 neighbour pairs, and the assigned pairs under the gate are *confirmed*.
 ``lambda_uv`` is the mean gamma over the confirmed pairs (a large value when there are
@@ -56,7 +56,7 @@ import numpy as np
 
 from ...solving.api import solve
 from ...problems.problem import AssignmentProblem
-from ..topology import (check_tracks, chi2_gate, heading_jacobians, heading_variance,
+from ..costs.topology import (check_tracks, chi2_gate, heading_jacobians, heading_variance,
                         pair_distances, reference_frames)
 
 __all__ = ["TopologyParams", "StepInputs", "prepare", "thresholds", "pair_gammas",

@@ -15,7 +15,7 @@ C. **Fine truncation** -- the paper's Steps 1-2 on each segment, literally, with
    options (:class:`TruncationOptions`).
 
 Every observation ends in exactly one relation (matched pair or isolated): the
-result is a :class:`~assocopt.tracking.group_matching.Relations`, which checks it.
+result is a :class:`~assocopt.tracking.belief.group_matching.Relations`, which checks it.
 
 A derived property (D, checked by the tests on random inputs under every
 combination of options): with undecided nodes isolated at the end, Step C's
@@ -55,7 +55,7 @@ from typing import Any, Sequence
 import numpy as np
 from numpy.typing import ArrayLike
 
-from ..group_matching import Relations
+from ..belief.group_matching import Relations
 
 __all__ = ["ORDERINGS", "TIE_BREAKS", "TRAVERSED_READINGS", "VISITED_READINGS",
            "MIDDLE_RULES", "TruncationOptions", "TruncationResult", "single_linkage_order",

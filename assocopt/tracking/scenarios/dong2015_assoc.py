@@ -70,7 +70,7 @@ from ..decide.nearest import gnn_assign, nearest_neighbour
 from ..decide.topology import (StepInputs, TopologyParams, assign_pairs, coarse_pregate,
                                degree_matrix, phi_matrix, prepare, thresholds,
                                trial_pairs)
-from ..topology import chi2_gate, headings
+from ..costs.topology import chi2_gate, headings
 from .dong2015 import Run
 
 __all__ = ["METHODS", "run_method", "position_costs", "step_metrics", "calibration",

@@ -37,7 +37,7 @@ from typing import Any
 
 import numpy as np
 
-from ..group_matching import Observations, Relations, true_relations
+from ..belief.group_matching import Observations, Relations, true_relations
 
 __all__ = ["Zhang2009", "Draw", "PAPER", "OURS", "TYPE_NAMES", "TYPE_ASSIGNMENTS",
            "NOISE_REFERENCES", "confusion_sets", "mean_nearest_distance"]

@@ -13,7 +13,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..runtime.errors import InvalidProblemError
+from ...runtime.errors import InvalidProblemError
 
 __all__ = ["CVScenario", "CrossingScenario", "Scans"]
 

@@ -25,8 +25,10 @@ from typing import Sequence
 import numpy as np
 from numpy.typing import ArrayLike
 
-from ..runtime.errors import InvalidProblemError
-from .localisation import COVARIANCES, RCOND_MIN, Localisation, PseudoMeasurements
+from ...runtime.errors import InvalidProblemError
+from .estimate import RCOND_MIN, Localisation
+from .geometry import COVARIANCES
+from .pseudo import PseudoMeasurements
 
 __all__ = ["azimuths", "localise_azimuths", "azimuth_pseudo_measurements",
            "planar_tuple_geometry"]

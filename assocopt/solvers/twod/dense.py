@@ -39,10 +39,10 @@ import time
 import numpy as np
 from scipy.optimize import linear_sum_assignment as _scipy_lsa
 
-from ..model.solution import Status
-from .base import RawResult, empty_answer
+from ...model.solution import Status
+from ..base import RawResult, empty_answer
 from .lap import LapInfeasibleError, augmented_matrix, linear_assignment
-from .sparse2d import (assign_sparse_edges, prefer_sparse, selected_from_edges,
+from .sparse import (assign_sparse_edges, prefer_sparse, selected_from_edges,
                        split_candidates)
 
 __all__ = ["assign_dense", "clipped_matrix", "solve_2d"]
@@ -92,7 +92,7 @@ def assign_dense(C: np.ndarray, rm: np.ndarray, cm: np.ndarray, slack: bool = Fa
     """Optimal ``col_of_row`` (``-1`` = row left out) and the form that was solved.
 
     ``slack``: a ``dense`` problem (misses are the free surplus of the larger side).
-    ``method``: the LAP engine of :func:`assocopt.solvers.lap.linear_assignment`.
+    ``method``: the LAP engine of :func:`assocopt.solvers.twod.lap.linear_assignment`.
     ``flags``: ``(all rm finite, all cm finite)`` if already known.
 
     Raises

@@ -29,10 +29,11 @@ from typing import Any, Iterable, Sequence
 import numpy as np
 from numpy.typing import ArrayLike
 
-from .belief import (InvalidMassError, check_vectors, conflict_matrix, conjunctive_vectors,
-                     discount_vectors, zhang_combination_vectors, zhang_conflict_matrix)
-from ..runtime.errors import AssocoptError
-from ..problems.validation import finite_floats
+from .combination import conflict_matrix, conjunctive_vectors, discount_vectors
+from .mass import InvalidMassError, check_vectors
+from .zhang import zhang_combination_vectors, zhang_conflict_matrix
+from ...runtime.errors import AssocoptError
+from ...problems.validation import finite_floats
 
 __all__ = [
     "MATCH_FRAME", "MEASURES", "SAME_SENSOR_READINGS", "MeasureParams", "Observations",

@@ -11,9 +11,9 @@ options, costs in the unscaled range:
   permutation (any size);
 * every row and column may be left out, no more rows than columns, at most
   :data:`SMALL` rows plus columns: the LAP of the clipped reduced costs
-  ``min(C - rm - cm, 0)`` of :mod:`assocopt.solvers.dense2d`, split and priced on
+  ``min(C - rm - cm, 0)`` of :mod:`assocopt.solvers.twod.dense`, split and priced on
   Python lists (for a scan's few rows each numpy call costs more than the work);
-* any other: :func:`~assocopt.solvers.dense2d.assign_dense` and
+* any other: :func:`~assocopt.solvers.twod.dense.assign_dense` and
   :meth:`~assocopt.problems.twod.Dense2D.check`, as the general route does.
 
 The answer is re-checked as the general route re-checks it (distinct columns in range,
@@ -31,11 +31,11 @@ import time
 import numpy as np
 from scipy.optimize import linear_sum_assignment as _lsa
 
-from .scaling import SCALE_ABOVE      # beyond it the general route answers
-from ..model.solution import Solution, Status
-from ..problems.twod import Checked
-from ..problems.twod_tables import _index_set, _pair_base, _row_offsets, _tuple_table
-from .dense2d import assign_dense
+from ..scaling import SCALE_ABOVE      # beyond it the general route answers
+from ...model.solution import Solution, Status
+from ...problems.twod import Checked
+from ...problems.twod_tables import _index_set, _pair_base, _row_offsets, _tuple_table
+from .dense import assign_dense
 from .lap import LapInfeasibleError
 
 __all__ = ["solve_direct", "SMALL"]

@@ -12,13 +12,13 @@ from typing import Any
 
 import numpy as np
 
-from ..model.formulation import LinearModel, build_model
-from ..problems.problem import AssignmentProblem
-from ..model.solution import Status
-from .base import Backend, Option, RawResult, SolveOptions, empty_answer, register
-from .interruptible import run_cancellable
+from ...model.formulation import LinearModel, build_model
+from ...problems.problem import AssignmentProblem
+from ...model.solution import Status
+from ..base import Backend, Option, RawResult, SolveOptions, empty_answer, register
+from ..interruptible import run_cancellable
 from .limited import ISOLATE, solve_isolated_or_here
-from .status import from_table, settle_optimal
+from ..status import from_table, settle_optimal
 
 __all__ = ["ScipyMilpBackend"]
 
@@ -62,7 +62,7 @@ class ScipyMilpBackend(Backend):
         opts: dict[str, object] = {"disp": bool(options.verbose),
                                    "mip_rel_gap": float(options.mip_gap)}
         if options.time_limit is not None:
-            # HiGHS presolve ignores the clock (see assocopt.solvers.highs): off with a limit
+            # HiGHS presolve ignores the clock (see assocopt.solvers.milp.highs): off with a limit
             opts["presolve"] = False
         opts.update(extra)
         t1 = time.perf_counter()

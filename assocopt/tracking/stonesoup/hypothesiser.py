@@ -51,7 +51,7 @@ try:
                                             TaggedWeightedGaussianStatePrediction)
     from stonesoup.updater.kalman import KalmanUpdater
 except ImportError as exc:  # pragma: no cover - exercised in a subprocess-free test
-    raise ImportError("assocopt.tracking.stonesoup_hypothesiser needs Stone Soup: "
+    raise ImportError("assocopt.tracking.stonesoup.hypothesiser needs Stone Soup: "
                       "pip install assocopt[stonesoup]") from exc
 
 __all__ = ["LinearGaussianMFAHypothesiser"]

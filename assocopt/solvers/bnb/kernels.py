@@ -2,7 +2,7 @@
 method with duals, the Lagrangian relaxation to a 2-D assignment with misses, and a
 depth-first exact-cover branch and bound on reduced costs.
 
-Importing this module imports numba; :mod:`assocopt.solvers.bnb` does so only inside
+Importing this module imports numba; :mod:`assocopt.solvers.bnb.backend` does so only inside
 ``solve``.  Functions are compiled on first use and cached on disk (``cache=True``).
 
 Notation (as in :mod:`assocopt.solvers.lagrangian`): ``K`` candidates, ``N`` axes,
@@ -19,13 +19,13 @@ the ascent only makes it tight.
 
 from typing import Any
 
-from .kernels import ensure, spent  # noqa: F401  (compile / cache-load clock)
-from .kernels.driver import (INFEASIBLE, PROVEN, STOPPED, recover3, solve,  # noqa: F401
+from ..kernels import ensure, spent  # noqa: F401  (compile / cache-load clock)
+from ..kernels.driver import (INFEASIBLE, PROVEN, STOPPED, recover3, solve,  # noqa: F401
                              tuple_index)
-from .kernels.hungarian import hungarian, hungarian_warm  # noqa: F401
-from .kernels.relaxation import (evaluate, full_reduced, improve_limit,  # noqa: F401
+from ..kernels.hungarian import hungarian, hungarian_warm  # noqa: F401
+from ..kernels.relaxation import (evaluate, full_reduced, improve_limit,  # noqa: F401
                                  prepare, raise_rows, reduced, sort_lists)
-from .kernels.search import BUDGET, COMPLETE, dfs  # noqa: F401
+from ..kernels.search import BUDGET, COMPLETE, dfs  # noqa: F401
 
 
 def cached(*kernels: Any) -> bool:

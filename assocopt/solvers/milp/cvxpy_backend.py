@@ -34,15 +34,15 @@ from typing import Any
 
 import numpy as np
 
-from ..runtime.errors import InvalidProblemError, SolverCapabilityError, SolverNotInstalledError
-from ..model.formulation import LinearModel, build_model
-from ..problems.problem import AssignmentProblem
-from ..model.solution import Status, relative_gap
-from .base import (Backend, Option, RawResult, SolveOptions, empty_answer, register,
+from ...runtime.errors import InvalidProblemError, SolverCapabilityError, SolverNotInstalledError
+from ...model.formulation import LinearModel, build_model
+from ...problems.problem import AssignmentProblem
+from ...model.solution import Status, relative_gap
+from ..base import (Backend, Option, RawResult, SolveOptions, empty_answer, register,
                    remaining)
-from .interruptible import run_cancellable
+from ..interruptible import run_cancellable
 from .limited import ISOLATE, solve_isolated_or_here
-from .status import from_table, settle_optimal
+from ..status import from_table, settle_optimal
 
 __all__ = ["CvxpyBackend"]
 
@@ -88,7 +88,7 @@ def _limit_options(solver: str, options: SolveOptions,
     gap_ = gap if is_mip else None
     if solver == "HIGHS":
         put("time_limit", opts, "time_limit", None if t is None else float(t))
-        if t is not None:       # HiGHS presolve ignores the clock (assocopt.solvers.highs)
+        if t is not None:       # HiGHS presolve ignores the clock (assocopt.solvers.milp.highs)
             opts["presolve"] = "off"
         put("mip_gap", opts, "mip_rel_gap", gap_)
         put("threads", opts, "threads", n)

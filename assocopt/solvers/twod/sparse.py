@@ -10,7 +10,7 @@ smallest of these exact forms:
 
 * no misses at all (``rm``, ``cm`` all ``inf``): the edges as they are, ``n1 = n2``;
 * every column may be left out: the *clipped reduced costs* of
-  :mod:`assocopt.solvers.dense2d` in edge-list form, ``n1`` rows by ``n2 + n1``
+  :mod:`assocopt.solvers.twod.dense` in edge-list form, ``n1`` rows by ``n2 + n1``
   columns.  Pair ``(i, j)`` costs ``r_ij = w_ij - cm_j - rm_i`` (``- cm_j`` alone for
   a row that must be assigned) and each row that may be left out gets one private
   column at cost 0 standing for its miss.  Row-complete assignments of this graph and
@@ -20,7 +20,7 @@ smallest of these exact forms:
   the transpose; with both, the smaller side as rows;
 * otherwise (some rows *and* some columns must be assigned) the classical
   ``(n1 + n2)``-square augmentation whose dummy block is the transposed edge pattern
-  (:func:`assocopt.solvers.lap.augmented_edges`).
+  (:func:`assocopt.solvers.twod.lap.augmented_edges`).
 
 Memory grows with the number of edges, not with ``n1 * n2``.  Without numba (a core
 dependency) scipy's LAPJVsp (:func:`scipy.sparse.csgraph.min_weight_full_bipartite_matching`)
@@ -178,7 +178,7 @@ def _lap(nr: int, nc: int, rows: np.ndarray, cols: np.ndarray, w: np.ndarray,
     if kernel is None:
         edge = _scipy_edges(nr, nc, rows, cols, w)
     else:
-        from .kernels import ensure
+        from ..kernels import ensure
         ensure(kernel, nr, nc, rows, cols, w)
         edge, bad = kernel(nr, nc, rows, cols, w)
         if bad >= 0:
@@ -211,7 +211,7 @@ def _kernel():
     """The compiled LAP (imported on first use: importing numba costs), or None."""
     if not _KERNEL:
         try:
-            from .kernels.sparse_lap import lap_edges
+            from ..kernels.sparse_lap import lap_edges
         except ImportError:
             lap_edges = None
         _KERNEL.append(lap_edges)

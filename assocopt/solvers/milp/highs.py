@@ -13,13 +13,13 @@ from typing import Any
 
 import numpy as np
 
-from ..runtime.errors import InvalidProblemError
-from ..model.formulation import LinearModel, build_model
-from ..problems.problem import AssignmentProblem
-from ..model.solution import Status
-from .base import Backend, RawResult, SolveOptions, empty_answer, register
+from ...runtime.errors import InvalidProblemError
+from ...model.formulation import LinearModel, build_model
+from ...problems.problem import AssignmentProblem
+from ...model.solution import Status
+from ..base import Backend, RawResult, SolveOptions, empty_answer, register
 from .limited import ISOLATE, solve_isolated_or_here
-from .status import from_table, settle_optimal
+from ..status import from_table, settle_optimal
 
 __all__ = ["HighsBackend", "highs_from_model"]
 
@@ -94,7 +94,7 @@ def run_highs(h: Any, deadline: float | None = None) -> None:
     the interrupt is re-raised when HiGHS has returned.  At ``deadline``
     (``time.perf_counter()``) HiGHS is asked to stop the same way, a safety net for
     the phases where its own ``time_limit`` is not checked."""
-    from .interruptible import run_cancellable
+    from ..interruptible import run_cancellable
 
     h.HandleUserInterrupt = True
     try:

@@ -14,9 +14,9 @@ import time
 
 import numpy as np
 
-from ..problems.problem import AssignmentProblem
-from ..model.solution import Status
-from .base import Backend, RawResult, SolveOptions, register
+from ...problems.problem import AssignmentProblem
+from ...model.solution import Status
+from ..base import Backend, RawResult, SolveOptions, register
 
 __all__ = ["GreedyBackend", "greedy_select", "take_in_order"]
 

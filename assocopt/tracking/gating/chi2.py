@@ -29,8 +29,8 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import ArrayLike
 
-from ..runtime.errors import InvalidProblemError
-from ..problems.validation import finite_floats
+from ...runtime.errors import InvalidProblemError
+from ...problems.validation import finite_floats
 
 __all__ = ["Gate", "chi2_threshold", "predict_measurements", "gate", "pair_statistics"]
 

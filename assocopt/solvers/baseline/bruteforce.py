@@ -18,9 +18,9 @@ from typing import Iterator
 
 import numpy as np
 
-from ..problems.problem import AssignmentProblem
-from ..model.solution import Status
-from .base import Backend, Option, RawResult, SolveOptions, register
+from ...problems.problem import AssignmentProblem
+from ...model.solution import Status
+from ..base import Backend, Option, RawResult, SolveOptions, register
 
 __all__ = ["BruteForceBackend", "enumerate_solutions", "count_solutions"]
 
@@ -72,7 +72,7 @@ def enumerate_solutions(problem: AssignmentProblem, *, max_nodes: int = DEFAULT_
     >>> sorted(s.tolist() for s in enumerate_solutions(p))
     [[0, 3], [1, 2]]
     """
-    from ..runtime.errors import ProblemTooLargeError
+    from ...runtime.errors import ProblemTooLargeError
 
     masks, by_row = _candidate_masks(problem)
     if deadline is not None and time.perf_counter() > deadline:
@@ -134,7 +134,7 @@ class BruteForceBackend(Backend):
     own_method = True
 
     def solve(self, problem: AssignmentProblem, options: SolveOptions) -> RawResult:
-        from ..runtime.errors import ProblemTooLargeError
+        from ...runtime.errors import ProblemTooLargeError
 
         max_nodes = self.settings(problem, options)["max_nodes"]
         t0 = time.perf_counter()

@@ -34,14 +34,14 @@ from typing import Any, Iterator
 
 import numpy as np
 
-from ..runtime.errors import InvalidProblemError, SolverNotInstalledError
-from ..model.formulation import LinearModel, build_model
-from ..problems.problem import AssignmentProblem
-from ..model.solution import Status, relative_gap
-from .base import Backend, Option, RawResult, SolveOptions, register, remaining
-from .interruptible import run_cancellable
+from ...runtime.errors import InvalidProblemError, SolverNotInstalledError
+from ...model.formulation import LinearModel, build_model
+from ...problems.problem import AssignmentProblem
+from ...model.solution import Status, relative_gap
+from ..base import Backend, Option, RawResult, SolveOptions, register, remaining
+from ..interruptible import run_cancellable
 from .limited import ISOLATE, solve_isolated_or_here
-from .status import from_table, settle_optimal
+from ..status import from_table, settle_optimal
 
 __all__ = ["OrtoolsMipBackend", "run_model"]
 

@@ -42,9 +42,9 @@ except ImportError as exc:  # pragma: no cover - exercised in a subprocess-free 
     raise ImportError("assocopt.tracking.stonesoup needs Stone Soup: "
                       "pip install assocopt[stonesoup]") from exc
 
-from ..solving.api import solve
-from ..problems.problem import AssignmentProblem
-from ..model.solution import Status
+from ...solving.api import solve
+from ...problems.problem import AssignmentProblem
+from ...model.solution import Status
 
 __all__ = ["AssocoptGNN", "AssocoptKBest", "AssocoptMFA", "hypotheses_problem",
            "mfa_reference_cost"]
@@ -199,7 +199,7 @@ class AssocoptKBest(Base):
 
     def rank_hypotheses(self, hypotheses) -> list:
         """The ``k`` best joint hypotheses of already generated ``hypotheses``."""
-        from ..ranking.kbest import kbest
+        from ...ranking.kbest import kbest
 
         if isinstance(self.k, bool) or int(self.k) != self.k or self.k < 1:
             raise ValueError(f"k must be a positive integer, got {self.k!r}")
@@ -268,8 +268,8 @@ class AssocoptMFA(DataAssociator):
 
     def associate_hypotheses(self, hypotheses) -> dict:
         """The pruned hypotheses of already generated ``hypotheses`` (track -> list)."""
-        from .mfa import log_costs, nscan_prune, ranked_window, solve_window, tag_arrays
-        from .mfa import window_problem
+        from ..mfa import log_costs, nscan_prune, ranked_window, solve_window, tag_arrays
+        from ..mfa import window_problem
 
         if isinstance(self.k, bool) or int(self.k) != self.k or self.k < 1:
             raise ValueError(f"k must be a positive integer, got {self.k!r}")

@@ -2,7 +2,7 @@
 
 Monte Carlo studies solve tens of thousands of small S-D problems (paper 002 alone
 solves 72,000), where per-call latency, not asymptotics, decides.  This back end
-runs everything in one compiled call (numba, :mod:`assocopt.solvers.bnb_kernels`):
+runs everything in one compiled call (numba, :mod:`assocopt.solvers.bnb.kernels`):
 
 1. *Ascent.*  The Lagrangian relaxation of :mod:`assocopt.solvers.lagrangian`: keep
    two axes, price the others with multipliers ``y``, solve the 2-D assignment with
@@ -67,13 +67,13 @@ from typing import Any
 
 import numpy as np
 
-from ..runtime.errors import ProblemTooLargeError
-from ..problems.problem import AssignmentProblem
-from ..model.solution import Status
-from ..problems.problem import OPT_TOL
-from .base import (Backend, Option, RawResult, SolveOptions, _distribution_version,
+from ...runtime.errors import ProblemTooLargeError
+from ...problems.problem import AssignmentProblem
+from ...model.solution import Status
+from ...problems.problem import OPT_TOL
+from ..base import (Backend, Option, RawResult, SolveOptions, _distribution_version,
                    empty_answer, get_backend, register)
-from .interruptible import new_stop, run_stoppable
+from ..interruptible import new_stop, run_stoppable
 
 __all__ = ["BranchBoundBackend", "DEFAULTS", "BnbInput", "MAX_DENSE", "MAX_KEPT",
            "kept_sizes", "too_large"]
@@ -130,7 +130,7 @@ class BnbInput:
 
     @classmethod
     def build(cls, problem: AssignmentProblem, keep_axes: Any = None) -> "BnbInput":
-        from . import bnb_kernels as kern
+        from . import kernels as kern
 
         a, b = problem.kept_axes(keep_axes)
         relaxed = np.array([s for s in range(problem.ndim) if s not in (a, b)],
@@ -190,7 +190,7 @@ class BranchBoundBackend(Backend):
         p = self.settings(problem, options)
         if (empty := empty_answer(problem, options, self.name)) is not None:
             return empty
-        from . import bnb_kernels as kern      # imports numba: only when asked for
+        from . import kernels as kern      # imports numba: only when asked for
         t0 = time.perf_counter()
         k0 = sum(kern.spent())    # compile / cache load: reported apart (api.solve)
 
@@ -273,7 +273,7 @@ class BranchBoundBackend(Backend):
         raw.info = dict(raw.info, bnb=info, requested="bnb", fallback=why)
         raw.solver = "lagrangian-exact"      # the method that produced the answer
         raw.message = f"bnb: {why}, then {raw.message}"
-        from . import bnb_kernels as kern
+        from . import kernels as kern
         kernels = sum(kern.spent()) - k0     # reported apart by api.solve
         raw.solve_time = max(time.perf_counter() - t0 - raw.build_time - kernels, 0.0)
         return raw

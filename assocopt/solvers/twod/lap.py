@@ -1,10 +1,10 @@
 """2-D linear assignment engines: dense (scipy or lapx), sparse, with miss costs, duals.
 
 This module owns the 2-D LAP: the engines and the augmentations that turn miss costs
-into a plain LAP; everything else on the 2-D path (:mod:`.sparse2d`, :mod:`.dense2d`,
+into a plain LAP; everything else on the 2-D path (:mod:`.sparse`, :mod:`.dense`,
 the ``scipy-lsa`` and ``lapjv`` back ends, the Lagrangian S-D solver
 :mod:`assocopt.solvers.lagrangian`) builds on it and it imports none of them at module
-level or inside (the compiled sparse LAP comes from :mod:`.kernels.sparse_lap`).
+level or inside (the compiled sparse LAP comes from :mod:`assocopt.solvers.kernels.sparse_lap`).
 
 * :func:`linear_assignment` -- a dense (possibly rectangular) LAP, ``inf`` = forbidden,
   scipy's semantics (the smaller side fully assigned).  It runs lapx's Jonker-Volgenant
@@ -13,7 +13,7 @@ level or inside (the compiled sparse LAP comes from :mod:`.kernels.sparse_lap`).
 * :func:`assign_with_misses` -- 2-D assignment with per-row and per-column
   non-assignment ("miss") costs, from a sparse edge list; it picks a dense matrix or,
   for large gated problems (or ``method="sparse"``), the compiled sparse LAP of
-  :mod:`.kernels.sparse_lap` (numba installed: no scipy matrix built per call, which
+  :mod:`assocopt.solvers.kernels.sparse_lap` (numba installed: no scipy matrix built per call, which
   the Lagrangian ascent makes hundreds of times), else scipy's sparse LAPJVsp
   (:func:`scipy.sparse.csgraph.min_weight_full_bipartite_matching`) on the standard
   augmentation whose dummy-dummy block is the transpose of the edge pattern; memory
@@ -86,7 +86,7 @@ def linear_assignment(C: np.ndarray, method: str = "auto") -> tuple[np.ndarray, 
     ([0, 1], [1, 0])
     """
     if method == "lapx" and not lapx_available():
-        from ..runtime.errors import SolverNotInstalledError
+        from ...runtime.errors import SolverNotInstalledError
         raise SolverNotInstalledError("method 'lapx' needs the Python package 'lapx': "
                                       "pip install lapx")
     if method == "lapx" or (method == "auto" and min(C.shape, default=0) >= _LAPX_MIN_N
@@ -193,16 +193,16 @@ def assign_with_misses(n1: int, n2: int, rows: np.ndarray, cols: np.ndarray,
 
 
 def _compiled_sparse() -> bool:
-    """Whether the compiled sparse LAP (:mod:`.kernels.sparse_lap`) can run."""
-    from .base import module_installed
+    """Whether the compiled sparse LAP (:mod:`assocopt.solvers.kernels.sparse_lap`) can run."""
+    from ..base import module_installed
     return module_installed("numba")
 
 
 def _compiled_lap(size: int, rows, cols, weights) -> tuple[np.ndarray, np.ndarray]:
     """A perfect matching of the square edge list by the compiled sparse LAP (no scipy
     matrix built per call, which the Lagrangian ascent makes hundreds of times)."""
-    from .kernels import ensure
-    from .kernels.sparse_lap import lap_edges
+    from ..kernels import ensure
+    from ..kernels.sparse_lap import lap_edges
     args = (size, size, np.ascontiguousarray(rows, np.int64),
             np.ascontiguousarray(cols, np.int64), np.ascontiguousarray(weights, np.float64))
     ensure(lap_edges, *args)

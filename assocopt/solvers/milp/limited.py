@@ -29,8 +29,8 @@ import time
 from pathlib import Path
 from typing import Any, Callable
 
-from ..model.solution import Status
-from .base import Option, RawResult, SolveOptions, remaining
+from ...model.solution import Status
+from ..base import Option, RawResult, SolveOptions, remaining
 
 __all__ = ["ISOLATE", "run_limited", "solve_isolated_or_here", "kill_slack",
            "killed_at_limit", "child_main"]
@@ -42,9 +42,9 @@ ISOLATE = Option("isolate", "bool", None,
                  "may overshoot the limit)", nullable=True)
 
 #: The package's parent folder, put first on the child's path (the same assocopt).
-_ROOT = str(Path(__file__).resolve().parents[2])
+_ROOT = str(Path(__file__).resolve().parents[3])
 _BOOT = ("import sys; sys.path.insert(0, sys.argv[1]); "
-         "from assocopt.solvers.limited import child_main; child_main()")
+         "from assocopt.solvers.milp.limited import child_main; child_main()")
 
 
 def kill_slack(limit: float) -> float:
@@ -129,7 +129,7 @@ def child_main() -> None:
     ``(kind, value, ready)`` to the original stdout (the solver's own output goes to
     stderr, so it cannot corrupt the answer)."""
     signal.signal(signal.SIGINT, signal.SIG_IGN)      # the parent handles Ctrl-C
-    from ..runtime.parent_watch import watch_parent
+    from ...runtime.parent_watch import watch_parent
     watch_parent(int(sys.argv[2]))
     answer = os.fdopen(os.dup(1), "wb")
     os.dup2(2, 1)

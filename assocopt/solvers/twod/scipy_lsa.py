@@ -1,20 +1,20 @@
 """2-D fast path: ``scipy.optimize.linear_sum_assignment`` (shortest augmenting path).
 
 The cases (square, rectangular, with non-assignment costs) are those of
-:mod:`assocopt.solvers.dense2d`: a problem built from a matrix is solved on that
+:mod:`assocopt.solvers.twod.dense`: a problem built from a matrix is solved on that
 matrix, miss costs through the ``n1 x (n2 + n1)`` reduced form (the classical
 ``(n1 + n2) x (n2 + n1)`` augmentation,
-:func:`assocopt.solvers.lap.augmented_matrix`, only when some rows
+:func:`assocopt.solvers.twod.lap.augmented_matrix`, only when some rows
 and some columns must be assigned); large gated candidate lists go to the sparse
-engine (:mod:`assocopt.solvers.sparse2d`).
+engine (:mod:`assocopt.solvers.twod.sparse`).
 """
 
 from __future__ import annotations
 
 import numpy as np
 
-from ..problems.problem import AssignmentProblem
-from .base import Backend, RawResult, SolveOptions, register
+from ...problems.problem import AssignmentProblem
+from ..base import Backend, RawResult, SolveOptions, register
 
 __all__ = ["ScipyLsaBackend"]
 
@@ -24,7 +24,7 @@ _SOLVE_2D = None
 @register
 class ScipyLsaBackend(Backend):
     """Exact 2-D assignment with ``scipy.optimize.linear_sum_assignment`` (large gated
-    candidate lists: the compiled sparse engine of :mod:`assocopt.solvers.sparse2d`)."""
+    candidate lists: the compiled sparse engine of :mod:`assocopt.solvers.twod.sparse`)."""
 
     name = "scipy-lsa"
     module = "scipy"
@@ -38,6 +38,6 @@ class ScipyLsaBackend(Backend):
         self.settings(problem, options)          # no options of its own: rejects any
         global _SOLVE_2D
         if _SOLVE_2D is None:            # imported on first use, then kept (hot path)
-            from .dense2d import solve_2d
+            from .dense import solve_2d
             _SOLVE_2D = solve_2d
         return _SOLVE_2D(problem, options, "scipy", self.name)

@@ -1,7 +1,7 @@
 """Stone Soup objects for assocopt's simulated scans (Stone Soup extra).
 
 The benchmarks and tests that run a Stone Soup tracker on a scenario of
-:mod:`assocopt.tracking.simulate` (or :mod:`assocopt.tracking.scenarios`) turn its
+:mod:`assocopt.tracking.scenarios.simulate` (or :mod:`assocopt.tracking.scenarios`) turn its
 arrays into Stone Soup's detections and tracks the same way; this is that way, once.
 """
 
@@ -18,7 +18,7 @@ try:
     from stonesoup.types.state import TaggedWeightedGaussianState
     from stonesoup.types.track import Track
 except ImportError as exc:  # pragma: no cover - exercised in a subprocess-free test
-    raise ImportError("assocopt.tracking.stonesoup_scenario needs Stone Soup: "
+    raise ImportError("assocopt.tracking.stonesoup.scenario needs Stone Soup: "
                       "pip install assocopt[stonesoup]") from exc
 
 __all__ = ["scan_detections", "mixture_tracks", "MIXTURE_COVAR"]

@@ -1,13 +1,13 @@
 """The optional ``lapjv`` 2-D back end: lapx's Jonker-Volgenant LAP (``pip install lapx``).
 
-The cases are those of ``scipy-lsa`` (:mod:`assocopt.solvers.dense2d`), with lapx's
-dense LAP (:func:`assocopt.solvers.lap.linear_assignment`) in place of scipy's.
+The cases are those of ``scipy-lsa`` (:mod:`assocopt.solvers.twod.dense`), with lapx's
+dense LAP (:func:`assocopt.solvers.twod.lap.linear_assignment`) in place of scipy's.
 """
 
 from __future__ import annotations
 
-from ..problems.problem import AssignmentProblem
-from .base import Backend, Option, RawResult, SolveOptions, register
+from ...problems.problem import AssignmentProblem
+from ..base import Backend, Option, RawResult, SolveOptions, register
 
 __all__ = ["LapjvBackend"]
 
@@ -16,8 +16,8 @@ __all__ = ["LapjvBackend"]
 class LapjvBackend(Backend):
     """Exact 2-D assignment with lapx's Jonker-Volgenant code (optional package).
 
-    Same cases as ``scipy-lsa`` (:mod:`assocopt.solvers.dense2d`); large gated
-    candidate lists use the sparse engine (:mod:`assocopt.solvers.sparse2d`).  Extra
+    Same cases as ``scipy-lsa`` (:mod:`assocopt.solvers.twod.dense`); large gated
+    candidate lists use the sparse engine (:mod:`assocopt.solvers.twod.sparse`).  Extra
     option ``method``: ``"auto"`` (default), ``"lapx"`` or ``"sparse"``.
     """
 
@@ -32,7 +32,7 @@ class LapjvBackend(Backend):
                       choices=("auto", "lapx", "sparse")),)
 
     def solve(self, problem: AssignmentProblem, options: SolveOptions) -> RawResult:
-        from .dense2d import solve_2d        # loads scipy: not when the back ends are listed
+        from .dense import solve_2d        # loads scipy: not when the back ends are listed
 
         method = self.settings(problem, options)["method"]
         mode = {"auto": "auto", "lapx": "dense", "sparse": "sparse"}[method]

@@ -16,10 +16,10 @@ from typing import Any
 
 import numpy as np
 
-from ..model.solution import Status
-from .base import SolveOptions
-from .bnb import DEFAULTS, INLINE_CANDIDATES, TOL
-from .interruptible import new_stop, run_stoppable
+from ...model.solution import Status
+from ..base import SolveOptions
+from .backend import DEFAULTS, INLINE_CANDIDATES, TOL
+from ..interruptible import new_stop, run_stoppable
 
 __all__ = ["solve_components", "batch_arrays", "run_batch"]
 
@@ -39,8 +39,8 @@ def run_batch(T: np.ndarray, c: np.ndarray, kp: np.ndarray, sizes: np.ndarray,
               ) -> tuple[tuple[np.ndarray, ...], bool]:
     """The kernel on ``(T, c, kp, sizes)`` (local tuples, ``sizes`` (parts, N)):
     ``((outcome, ub, bound, chosen), stopped_by_clock)``."""
-    from .kernels import ensure
-    from .kernels.batch import solve_batch
+    from ..kernels import ensure
+    from ..kernels.batch import solve_batch
     p = dict(DEFAULTS, **(params or {}))
     args = (np.ascontiguousarray(T, np.int64), np.ascontiguousarray(c, np.float64),
             kp, np.ascontiguousarray(sizes, np.int64), TOL, p["max_iter"],
@@ -70,7 +70,7 @@ def solve_components(problem: Any, T: np.ndarray, csizes: np.ndarray, sp: Any,
     deadline = None if left is None else time.perf_counter() + max(left, 0.0)
     (outcome, ub, lb, chosen), by_clock = run_batch(Tb, cb, kp, csizes[comps], params,
                                                     deadline)
-    from .kernels.driver import INFEASIBLE, PROVEN
+    from ..kernels.driver import INFEASIBLE, PROVEN
     proven = outcome == PROVEN
     found = np.isfinite(ub)
     cand = np.concatenate(parts)

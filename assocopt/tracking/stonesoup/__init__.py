@@ -1,0 +1,23 @@
+"""assocopt inside Stone Soup (optional extra: ``pip install assocopt[stonesoup]``).
+
+* :mod:`.associators` -- assocopt as Stone Soup data associators: GNN
+  (:class:`AssocoptGNN`), ranked joint hypotheses (:class:`AssocoptKBest`) and
+  multi-frame assignment (:class:`AssocoptMFA`), with :func:`hypotheses_problem` and
+  :func:`mfa_reference_cost`;
+* :mod:`.hypothesiser` -- Stone Soup's MFA hypotheses for linear-Gaussian models,
+  batched (:class:`~.hypothesiser.LinearGaussianMFAHypothesiser`);
+* :mod:`.scenario` -- Stone Soup detections and tracks of assocopt's simulated scans.
+
+Importing this package imports Stone Soup (a clear error names the extra when it is
+missing); the hypothesiser and the scenario helpers load when imported themselves.
+
+May import: the core (:mod:`assocopt.solving`, :mod:`assocopt.ranking`,
+:mod:`assocopt.problems`, :mod:`assocopt.model`) and, in the tracking layer,
+:mod:`assocopt.tracking.mfa`.
+"""
+
+from .associators import (AssocoptGNN, AssocoptKBest, AssocoptMFA, hypotheses_problem,
+                          mfa_reference_cost)
+
+__all__ = ["AssocoptGNN", "AssocoptKBest", "AssocoptMFA", "hypotheses_problem",
+           "mfa_reference_cost"]
