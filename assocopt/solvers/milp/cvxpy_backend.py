@@ -35,12 +35,12 @@ from typing import Any
 import numpy as np
 
 from ...runtime.errors import InvalidProblemError, SolverCapabilityError, SolverNotInstalledError
-from ...model.formulation import LinearModel, build_model
+from ...model.formulation import LinearModel
 from ...problems.problem import AssignmentProblem
 from ...model.solution import Status, relative_gap
-from ..base import (Backend, Option, RawResult, SolveOptions, empty_answer, register,
-                   remaining)
+from ..base import Backend, Option, RawResult, SolveOptions, register, remaining
 from ..interruptible import run_cancellable
+from .answer import opening, built_model, note_isolated, take_point
 from .limited import ISOLATE, solve_isolated_or_here
 from ..status import from_table, settle_optimal
 
@@ -182,13 +182,10 @@ class CvxpyBackend(Backend):
 
     def solve(self, problem: AssignmentProblem, options: SolveOptions) -> RawResult:
         is_mip = options.relax is None
-        extra = self.settings(problem, options)
-        isolate = extra.pop("isolate", None)
-        if (empty := empty_answer(problem, options, self.name)) is not None:
+        extra, isolate, empty = opening(self, problem, options)
+        if empty is not None:
             return empty
-        t0 = time.perf_counter()
-        start = time.monotonic()
-        model = build_model(problem, options.relax)
+        model, t0, start = built_model(problem, options)
         t_model = time.perf_counter()
         args = (model, extra["cvxpy_solver"], dict(extra["solver_options"]),
                 dataclasses.replace(options, extra={}, parsed=True))
@@ -197,10 +194,8 @@ class CvxpyBackend(Backend):
                                      start, t0, t0)
         if isinstance(out, RawResult):
             return out
-        info: dict[str, Any] = {"cvxpy_solver": out["solver"],
-                                "limits_passed": out["limits_passed"]}
-        if "startup" in out:
-            info["isolated"] = round(out["startup"], 4)
+        info: dict[str, Any] = note_isolated({"cvxpy_solver": out["solver"],
+                                              "limits_passed": out["limits_passed"]}, out)
         solver, build, solve_time = out["solver"], out["build_time"], out["solve_time"]
         build += t_model - t0                  # assocopt's CSR model, then CVXPY's
         if "solver_error" in out:
@@ -218,16 +213,13 @@ class CvxpyBackend(Backend):
         values, objective, bound = out["x"], None, None
         if values is not None and native in ("optimal", "optimal_inaccurate", "user_limit"):
             objective = out["objective"]
+            take_point(result, values, objective, is_mip)
             if is_mip:
-                selected = np.flatnonzero(values > 0.5)
                 # A limit-stopped solver may hand back a non-incumbent point: keep
                 # only a selection that is a feasible assignment.
-                if native == "optimal" or problem.violations(selected) is None:
-                    result.selected = selected
+                if native != "optimal" and problem.violations(result.selected) is not None:
+                    result.selected = None
                 bound = result.bound = out["bound"]
-            else:
-                result.x = values
-                result.objective = objective
         result.status, note = self._status(native, solver, objective, bound, options,
                                            is_mip, solve_time)
         result.message = f"cvxpy/{solver}: {native}" + (f"; {note}" if note else "")

@@ -14,10 +14,11 @@ from typing import Any
 import numpy as np
 
 from ...runtime.errors import InvalidProblemError
-from ...model.formulation import LinearModel, build_model
+from ...model.formulation import LinearModel
 from ...problems.problem import AssignmentProblem
 from ...model.solution import Status
-from ..base import Backend, RawResult, SolveOptions, empty_answer, register
+from ..base import Backend, RawResult, SolveOptions, register
+from .answer import opening, built_model, note_isolated, take_point
 from .limited import ISOLATE, solve_isolated_or_here
 from ..status import from_table, settle_optimal
 
@@ -146,13 +147,10 @@ class HighsBackend(Backend):
         return cls.is_available() and name in _highs_option_names()
 
     def solve(self, problem: AssignmentProblem, options: SolveOptions) -> RawResult:
-        extra = self.settings(problem, options)
-        isolate = extra.pop("isolate", None)
-        if (empty := empty_answer(problem, options, self.name)) is not None:
+        extra, isolate, empty = opening(self, problem, options)
+        if empty is not None:
             return empty
-        t0 = time.perf_counter()
-        start = time.monotonic()
-        model = build_model(problem, options.relax)
+        model, t0, start = built_model(problem, options)
         sub = SolveOptions(relax=options.relax, time_limit=options.time_limit,
                            mip_gap=options.mip_gap, threads=options.threads,
                            verbose=options.verbose, extra=extra, parsed=True)
@@ -171,18 +169,9 @@ class HighsBackend(Backend):
         gap = out["mip_gap"] if model.is_mip else 0.0
         status = settle_optimal(from_table(_STATUS_TABLE, out["status"]), gap,
                                 options.mip_gap if model.is_mip else 0.0)[0]
-        info = {"highs_status": out["status"], "presolve": out["presolve"],
-                "mip_node_count": out["nodes"]}
-        if "startup" in out:
-            info["isolated"] = round(out["startup"], 4)
+        info = note_isolated({"highs_status": out["status"], "presolve": out["presolve"],
+                              "mip_node_count": out["nodes"]}, out)
         result = RawResult(status=status, message=f"HiGHS: {out['message']}",
                            build_time=build_time, solve_time=out["solve_time"],
                            bound=bound, info=info)
-        x = out["x"]
-        if x is not None:
-            if model.is_mip:
-                result.selected = np.flatnonzero(x > 0.5)
-            else:
-                result.x = x
-                result.objective = out["objective"]
-        return result
+        return take_point(result, out["x"], out["objective"], model.is_mip)

@@ -35,11 +35,12 @@ from typing import Any
 import numpy as np
 
 from ...runtime.errors import InvalidProblemError
-from ...model.formulation import LinearModel, build_model
+from ...model.formulation import LinearModel
 from ...problems.problem import AssignmentProblem
 from ...model.solution import Status, relative_gap
 from ..base import Backend, Option, RawResult, SolveOptions, register, remaining
 from ..interruptible import run_cancellable
+from .answer import built_model, note_isolated
 from .limited import ISOLATE, solve_isolated_or_here
 from ..status import from_table, settle_optimal
 
@@ -213,9 +214,7 @@ class CpSatBackend(Backend):
         extra = self.settings(problem, options)
         scale_opt = extra.pop("scale")
         isolate = extra.pop("isolate", None)
-        t0 = time.perf_counter()
-        start = time.monotonic()
-        model = build_model(problem, options.relax)
+        model, t0, start = built_model(problem, options)
         n_rows = model.shape[0]
         scale, icosts, max_err = _scaled_costs(model.c, n_rows, scale_opt)
         sub = SolveOptions(relax=options.relax, time_limit=options.time_limit,
@@ -237,8 +236,7 @@ class CpSatBackend(Backend):
             "random_seed": out["random_seed"], "num_conflicts": out["num_conflicts"],
             "num_branches": out["num_branches"], "cpsat_wall_time": out["wall_time"],
         }
-        if "startup" in out:
-            info["isolated"] = round(out["startup"], 4)
+        note_isolated(info, out)
         # the proto's filling counts as building, as it did in this process
         result = RawResult(status=Status.ERROR, info=info,
                            build_time=t1 - t0 + out["fill_time"], solve_time=out["solve_time"])

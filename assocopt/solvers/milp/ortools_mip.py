@@ -35,11 +35,12 @@ from typing import Any, Iterator
 import numpy as np
 
 from ...runtime.errors import InvalidProblemError, SolverNotInstalledError
-from ...model.formulation import LinearModel, build_model
+from ...model.formulation import LinearModel
 from ...problems.problem import AssignmentProblem
 from ...model.solution import Status, relative_gap
 from ..base import Backend, Option, RawResult, SolveOptions, register, remaining
 from ..interruptible import run_cancellable
+from .answer import built_model, note_isolated, take_point
 from .limited import ISOLATE, solve_isolated_or_here
 from ..status import from_table, settle_optimal
 
@@ -220,9 +221,7 @@ class OrtoolsMipBackend(Backend):
                 f"ortools-mip backend {backend!r} is not available in this OR-Tools build "
                 "(or its library is not installed)")
 
-        t0 = time.perf_counter()
-        start = time.monotonic()
-        model = build_model(problem, options.relax)
+        model, t0, start = built_model(problem, options)
         text, passed = _parameter_text(backend, options, is_mip, user_text)
         sub = SolveOptions(relax=options.relax, time_limit=options.time_limit,
                            mip_gap=options.mip_gap, threads=options.threads,
@@ -240,21 +239,14 @@ class OrtoolsMipBackend(Backend):
         info: dict[str, Any] = {"ortools_status": native, "ortools_backend": backend,
                                 "mip_gap_passed": passed["mip_gap"],
                                 "threads_passed": passed["threads"]}
-        if "startup" in out:
-            info["isolated"] = round(out["startup"], 4)
         result = RawResult(status=Status.ERROR, build_time=t1 - t0 + out["fill_time"],
-                           solve_time=out["solve_time"], info=info)
+                           solve_time=out["solve_time"], info=note_isolated(info, out))
         objective = bound = None
-        x = out["x"]
-        if x is not None:
+        if out["x"] is not None:
             objective = out["objective"]
-            if is_mip:
-                result.selected = np.flatnonzero(x > 0.5)
-                if np.isfinite(out["bound"]):
-                    bound = result.bound = out["bound"]
-            else:
-                result.x = x
-                result.objective = objective
+            take_point(result, out["x"], objective, is_mip)
+            if is_mip and np.isfinite(out["bound"]):
+                bound = result.bound = out["bound"]
         # the limit counts from t0 (in a child too, where the model was filled again)
         result.status, note = self._status(native, objective, bound, options,
                                            time.perf_counter() - t0)

@@ -12,11 +12,12 @@ from typing import Any
 
 import numpy as np
 
-from ...model.formulation import LinearModel, build_model
+from ...model.formulation import LinearModel
 from ...problems.problem import AssignmentProblem
 from ...model.solution import Status
-from ..base import Backend, Option, RawResult, SolveOptions, empty_answer, register
+from ..base import Backend, Option, RawResult, SolveOptions, register
 from ..interruptible import run_cancellable
+from .answer import opening, built_model, note_isolated, take_point
 from .limited import ISOLATE, solve_isolated_or_here
 from ..status import from_table, settle_optimal
 
@@ -52,13 +53,11 @@ class ScipyMilpBackend(Backend):
     )
 
     def solve(self, problem: AssignmentProblem, options: SolveOptions) -> RawResult:
-        extra = {k: v for k, v in self.settings(problem, options).items() if v is not None}
-        isolate = extra.pop("isolate", None)
-        if (empty := empty_answer(problem, options, self.name)) is not None:
+        extra, isolate, empty = opening(self, problem, options)
+        if empty is not None:
             return empty
-        t0 = time.perf_counter()
-        start = time.monotonic()
-        model = build_model(problem, options.relax)
+        extra = {k: v for k, v in extra.items() if v is not None}
+        model, t0, start = built_model(problem, options)
         opts: dict[str, object] = {"disp": bool(options.verbose),
                                    "mip_rel_gap": float(options.mip_gap)}
         if options.time_limit is not None:
@@ -77,16 +76,8 @@ class ScipyMilpBackend(Backend):
         out = RawResult(status=status, message=f"scipy.milp: {res['message']}",
                         build_time=t1 - t0, solve_time=t2 - t1,
                         bound=float(bound) if bound is not None and np.isfinite(bound) else None,
-                        info={"scipy_status": res["status"]})
-        if "startup" in res:
-            out.info["isolated"] = round(res["startup"], 4)
-        if res["x"] is not None:
-            if model.is_mip:
-                out.selected = np.flatnonzero(res["x"] > 0.5)
-            else:
-                out.x = np.asarray(res["x"], dtype=np.float64)
-                out.objective = float(res["fun"])
-        return out
+                        info=note_isolated({"scipy_status": res["status"]}, res))
+        return take_point(out, res["x"], res["fun"], model.is_mip)
 
 
 def run_model(model: LinearModel, opts: dict[str, object], *,

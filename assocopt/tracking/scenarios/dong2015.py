@@ -36,7 +36,7 @@ from typing import Any
 
 import numpy as np
 
-from .xue1999_tracker import _cv_model
+from ..filters import cv_model
 
 __all__ = ["Dong2015", "Run", "Step", "OURS"]
 
@@ -159,7 +159,7 @@ class Dong2015:
 
     def _track(self, z: np.ndarray, R: np.ndarray) -> list[tuple[np.ndarray, np.ndarray]]:
         """Local Kalman tracks after each measurement 1..K-1 (two-point start)."""
-        F, Q = _cv_model(self.T, self.q)
+        F, Q = cv_model(self.T, self.q)
         T = self.T
         x = np.concatenate([z[1], (z[1] - z[0]) / T], -1)
         n = z.shape[1]

@@ -48,6 +48,7 @@ from scipy.stats import chi2
 
 from ..decide.did import DIDParams, did_decide, initial_states, relative_errors
 from ..decide.nearest import gnn_assign, nearest_neighbour
+from ..filters import cv_model
 from .xue1999 import Scan, Xue1999
 
 __all__ = ["TrackerParams", "METHODS", "CONFLICTS", "RunLog", "run_tracker", "run_metrics",
@@ -173,13 +174,6 @@ class RunLog:
                                                      "nonconverged": 0, "conflicts": 0})
 
 
-def _cv_model(T: float, q: float) -> tuple[np.ndarray, np.ndarray]:
-    I2 = np.eye(2)
-    F = np.block([[I2, T * I2], [0 * I2, I2]])
-    Q = q * np.block([[T ** 3 / 3 * I2, T ** 2 / 2 * I2], [T ** 2 / 2 * I2, T * I2]])
-    return F, Q
-
-
 def association_costs(z: np.ndarray, z_iff: np.ndarray, x: np.ndarray, S: np.ndarray,
                       t_iff: np.ndarray, iff_cost: float) -> np.ndarray:
     """Reports x tracks: Mahalanobis distance on (x, y, vx, vy) + ``iff_cost`` per IFF
@@ -255,7 +249,7 @@ def run_tracker(scans: list[Scan], method: str, sc: Xue1999,
     base, over = split_method(method)
     opts = METHODS[base]
     p = replace(params or TrackerParams(), **over)
-    F, Q = _cv_model(sc.T, p.q)
+    F, Q = cv_model(sc.T, p.q)
     Rm = np.diag(sc.sigma ** 2)
     tr = _Tracks(np.zeros((0, 4)), np.zeros((0, 4, 4)))
     log = RunLog()
