@@ -61,9 +61,19 @@ def _public(mod: ModuleType) -> list[str]:
 
 
 def _home(modname: str, name: str, modules: list[str]) -> str:
-    """Where ``modname.name`` is documented: a public submodule exporting the very same
-    object, else ``modname`` itself."""
-    obj = getattr(importlib.import_module(modname), name)
+    """Where ``modname.name`` is documented: the shallowest public module that lists the
+    very same object in its ``__all__`` (a package's ``__all__`` is its public face, so
+    ``assocopt.tracking.stonesoup.AssocoptGNN`` is documented there, not in the module
+    that happens to define it), else ``modname`` itself."""
+    mod = importlib.import_module(modname)
+    obj = getattr(mod, name)
+    for parent in modules:
+        if modname.startswith(parent + "."):
+            pmod = importlib.import_module(parent)
+            if name in getattr(pmod, "__all__", ()) and getattr(pmod, name, None) is obj:
+                return parent
+    if name in getattr(mod, "__all__", ()) and hasattr(mod, "__path__"):
+        return modname
     for sub in modules:
         if sub.startswith(modname + ".") and sub != modname:
             submod = importlib.import_module(sub)
@@ -81,6 +91,12 @@ def public_api() -> dict[str, list[tuple[str, str]]]:
     return api
 
 
+def _relative(module: str, home: str) -> str:
+    """``home`` as autosummary resolves it from ``module``: relative below, absolute
+    above."""
+    return home[len(module) + 1:] if home.startswith(module + ".") else home
+
+
 def _title(text: str, char: str = "=") -> list[str]:
     return [text, char * len(text), ""]
 
@@ -96,9 +112,9 @@ def _module_page(module: str, entries: list[tuple[str, str]], title: str | None,
         lines += [".. autosummary::", f"   :toctree: .", ""]
         lines += [f"   {n}" for n in own] + [""]
     if moved:
-        lines += ["Also importable from here (documented in the submodule):", "",
+        lines += ["Also importable from here (documented at the path shown):", "",
                   ".. autosummary::", ""]
-        lines += [f"   {home[len(module) + 1:]}.{n}" for n, home in moved] + [""]
+        lines += [f"   {_relative(module, home)}.{n}" for n, home in moved] + [""]
     if submodules:
         lines += _title("Submodules", "-") + [".. toctree::", "   :maxdepth: 1", ""]
         lines += [f"   {s}" for s in submodules] + [""]
