@@ -76,6 +76,7 @@ def time_once(argv: list[str]) -> tuple[float, float]:
 
 def measure(rounds: int) -> dict[str, Any]:
     """Warm every command, then time ``rounds`` interleaved rounds; best of each."""
+    load_start = os.getloadavg()[0]
     for _key, _what, argv, _target in COMMANDS:
         time_once(argv)
     times: dict[str, list[float]] = {key: [] for key, *_ in COMMANDS}
@@ -98,7 +99,8 @@ def measure(rounds: int) -> dict[str, Any]:
                      "cpu_ratio": round(min(cpu[key]) / base_cpu, 3)})
     return {"rounds": rounds, "baseline": f'python -c "{BASELINE}"',
             "machine": {"python": platform.python_version(), "system": platform.system(),
-                        "machine": platform.machine(), "cpus": os.cpu_count()},
+                        "machine": platform.machine(), "cpus": os.cpu_count(),
+                        "load": [round(load_start, 2), round(os.getloadavg()[0], 2)]},
             "versions": _versions(), "rows": rows}
 
 
@@ -132,7 +134,10 @@ def render(data: dict[str, Any]) -> str:
         "first on `PYTHONPATH`, from the repository root.",
         "",
         f"Machine: Python {m['python']}, {m['system']} {m['machine']}, {m['cpus']} CPUs; "
-        f"numpy {v['numpy']}, scipy {v['scipy']}, numba {v['numba']}.",
+        f"numpy {v['numpy']}, scipy {v['scipy']}, numba {v['numba']}"
+        + (f"; load average {m['load'][0]:.1f} at the start, {m['load'][1]:.1f} at the end "
+           "(a shared machine: the absolute times grow with the load, the ratios less)."
+           if "load" in m else "."),
         "",
         "| command | best (s) | ratio to baseline | target | met | CPU best (s) | CPU ratio |",
         "|---|---|---|---|---|---|---|",

@@ -411,6 +411,19 @@ def test_each_concept_is_found_by_file_name():
         assert (PKG / rel).is_file(), rel
 
 
+def test_every_package_is_on_the_layout_page():
+    """The README's Layout (also the site's layout page) names every package, at every
+    depth (``solvers/twod/``, ``tracking/stonesoup/``), so a moved room shows there."""
+    layout = (ROOT / "README.md").read_text(encoding="utf-8").split("## Layout", 1)[1]
+    layout = layout.split("\n## ", 1)[0]
+    packages = sorted(p.parent.relative_to(PKG).as_posix() for p in PKG.rglob("__init__.py")
+                      if p.parent != PKG and "__pycache__" not in p.parts)
+    missing = [rel for rel in packages if f"{rel.rsplit('/', 1)[-1]}/`" not in layout]
+    assert not missing, f"packages the README's Layout does not name: {missing}"
+    page = (ROOT / "docs" / "layout.md").read_text(encoding="utf-8")
+    assert '"## Layout"' in page and "{include} ../README.md" in page
+
+
 # ----------------------------------------------------------------- self-contained docs
 #: Files a user does not have, and the section / erratum ids of those files.
 _CITES = re.compile("|".join([
