@@ -100,3 +100,58 @@ def test_bad_compatibility_is_named():
         gated_tuples((2, 2), {(0, 1): np.ones((3, 2), bool)}, 1.0)
     with pytest.raises(InvalidProblemError, match="must be a sensor pair"):
         gated_tuples((2, 2), {(1, 0): np.ones((2, 2), bool)}, 1.0)
+
+
+def _forms(M: np.ndarray, rng) -> list:
+    """One compatibility matrix in every form gated_tuples accepts."""
+    from scipy import sparse
+    i, j = np.nonzero(M)
+    pairs = np.stack([i, j], axis=1).astype(np.int64)
+    dup = pairs[rng.integers(0, len(pairs), size=len(pairs) // 2)] if len(pairs) else pairs
+    coo = sparse.coo_matrix((np.ones(len(i), bool), (i, j)), shape=M.shape)
+    return [sparse.csr_matrix(M), sparse.csc_array(M), coo,
+            np.concatenate([pairs, dup])[rng.permutation(len(pairs) + len(dup))]]
+
+
+@given(st.integers(0, 10_000), st.integers(2, 4), st.booleans(), st.booleans())
+def test_sparse_and_index_pair_forms_give_the_dense_result(seed, N, miss, clutter):
+    rng = np.random.default_rng(seed)
+    sizes = tuple(int(v) for v in rng.integers(0, 5, size=N))
+    pd = np.where(rng.random(N) < 0.5, 1.0, 0.8) if miss else np.ones(N)
+    cd = rng.choice([0.0, 0.5], size=N) if clutter else np.zeros(N)
+    ok = {(s, t): rng.random((sizes[s], sizes[t])) < 0.4
+          for s, t in itertools.combinations(range(N), 2) if rng.random() < 0.8}
+    want = gated_tuples(sizes, ok, pd, cd)
+    per_key = {k: _forms(M, rng) for k, M in ok.items()}
+    for f in range(4):
+        got = gated_tuples(sizes, {k: v[f] for k, v in per_key.items()}, pd, cd)
+        assert np.array_equal(got, want), f
+    mixed = {k: v[int(rng.integers(0, 4))] for k, v in per_key.items()}
+    assert np.array_equal(gated_tuples(sizes, mixed, pd, cd), want)
+
+
+def test_sparse_gates_never_allocate_the_pair_matrices():
+    """20 000 measurements a sensor: a dense compatibility matrix would take 400 MB."""
+    import tracemalloc
+    from scipy import sparse
+    n = 20_000
+    rng = np.random.default_rng(0)
+    perm = [rng.permutation(n) for _ in range(3)]
+    eye = {(s, t): sparse.csr_matrix((np.ones(n, bool), (perm[s], perm[t])), shape=(n, n))
+           for s, t in itertools.combinations(range(3), 2)}
+    tracemalloc.start()
+    T = gated_tuples((n, n, n), eye, 0.9)
+    peak = tracemalloc.get_traced_memory()[1]
+    tracemalloc.stop()
+    assert peak < 60e6
+    full = T[(T > 0).all(axis=1)]
+    assert len(full) == n and len(T) == 7 * n       # triples, three pair kinds, singles
+    assert (perm[1][np.argsort(perm[0])][full[:, 0] - 1] == full[:, 1] - 1).all()
+
+
+def test_bad_index_pairs_are_named():
+    with pytest.raises(InvalidProblemError, match=r"index pairs must lie in"):
+        gated_tuples((2, 2), {(0, 1): np.array([[0, 2]])}, 1.0)
+    with pytest.raises(InvalidProblemError, match=r"must have shape"):
+        from scipy import sparse
+        gated_tuples((2, 2), {(0, 1): sparse.csr_matrix((3, 2), dtype=bool)}, 1.0)
