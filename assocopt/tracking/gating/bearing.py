@@ -17,6 +17,7 @@ import numpy as np
 from ..costs.sd_builder import Scan, tuple_costs, tuple_geometry
 from ...runtime.errors import InvalidProblemError
 from ...problems.problem import AssignmentProblem
+from .chi2 import chi2_threshold
 from .tuples import gated_tuples
 
 __all__ = ["bearing_pair_gate", "build_gated_problem"]
@@ -52,8 +53,6 @@ def bearing_pair_gate(scan: Scan, *, probability: float = 0.99,
     apply.  ``localiser`` defaults to ``"ils"`` (maximum likelihood) in 3-D and
     ``"ls"`` in the plane.
     """
-    from scipy.stats import chi2
-
     if not 0.0 < probability <= 1.0:
         raise InvalidProblemError(f"probability must lie in (0, 1], got {probability}")
     T, spans = _pair_tuples(scan.sizes)
@@ -71,7 +70,7 @@ def bearing_pair_gate(scan: Scan, *, probability: float = 0.99,
     if dof > 0 and probability < 1.0:
         stat = 2.0 * tuple_costs(scan, g, "pattipati", normalisation="none").data
         with np.errstate(invalid="ignore"):
-            ok &= stat <= chi2.ppf(probability, dof)
+            ok &= stat <= chi2_threshold(probability, dof)
     return {key: ok[a:b].reshape(scan.sizes[key[0]], scan.sizes[key[1]])
             for key, a, b in spans}
 
