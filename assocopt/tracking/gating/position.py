@@ -80,7 +80,7 @@ def check_reports(reports: Sequence[ArrayLike], R: Sequence[ArrayLike] | ArrayLi
             a = np.broadcast_to(a, (len(z), d, d))
             rep = a[:1]
         elif a.shape == (len(z), d, d):
-            rep = a
+            rep = a[:1] if len(a) and a.strides[0] == 0 else a
         else:
             raise InvalidProblemError(f"R of sensor {s} must have shape ({d}, {d}) or "
                                       f"({len(z)}, {d}, {d}), got {a.shape}")
@@ -96,7 +96,8 @@ def check_reports(reports: Sequence[ArrayLike], R: Sequence[ArrayLike] | ArrayLi
             lam = np.linalg.eigvalsh(rep)[:, 0]
             bad = np.flatnonzero(~(lam > 0))
             if len(bad):
-                what = f"R of sensor {s}" + ("" if rep is not a else f" (report {int(bad[0])})")
+                what = f"R of sensor {s}" + ("" if rep.shape[0] != len(z) or len(z) == 1 and a.strides[0] == 0
+                                             else f" (report {int(bad[0])})")
                 raise InvalidProblemError(f"{what} is not positive definite "
                                           f"(smallest eigenvalue {lam[bad[0]]:.3g})")
         out.append(a)
