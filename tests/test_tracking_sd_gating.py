@@ -219,3 +219,17 @@ def test_prefilter_keeps_few_more_than_the_exact_test(seed):
         cand = len(bg._epipolar_candidates(scan, s, t, bg.chi2_threshold(0.99, 1))[0])
         assert M.nnz <= cand < 2 * M.nnz + 50
         assert cand < 0.3 * 120 * 120
+
+
+@pytest.mark.parametrize("method", ["pattipati", "skld-exact", "pattipati-ml"])
+def test_costs_in_chunks_equal_the_costs_of_all_tuples(method):
+    from assocopt.tracking.costs.sd_builder import tuple_costs_in_chunks
+    from assocopt.tracking.costs.sd_builder import COST_LOCALISER
+    sc = Lu2013(n_targets=5, d=2.0, sensors_km=FIVE[:3], pd=0.8, clutter_rate=1.0)
+    scan, _ = sc.simulate(np.random.default_rng(2))
+    T = candidate_tuples(scan.sizes, scan.pd, scan.clutter_density)
+    g = tuple_geometry(scan, T, localiser=COST_LOCALISER.get(method, "ls"))
+    want = tuple_costs(scan, g, method).total
+    got = tuple_costs_in_chunks(scan, T, method, chunk=17)
+    assert np.array_equal(np.isinf(got), np.isinf(want))
+    assert got[np.isfinite(want)] == pytest.approx(want[np.isfinite(want)], rel=1e-12)

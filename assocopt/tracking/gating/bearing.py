@@ -16,7 +16,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..costs.sd_builder import Scan, tuple_costs, tuple_geometry
+from ..costs.sd_builder import Scan, tuple_costs, tuple_costs_in_chunks, tuple_geometry
 from ...runtime.errors import InvalidProblemError
 from ...problems.problem import AssignmentProblem
 from .chi2 import chi2_threshold
@@ -273,7 +273,7 @@ def build_gated_problem(scan: Scan, method: str = "pattipati", *,
     ok = bearing_pair_gate(scan, probability=probability, max_range=max_range,
                            localiser=pair_localiser)
     T = gated_tuples(scan.sizes, ok, scan.pd, scan.clutter_density)
-    g = tuple_geometry(scan, T, localiser=localiser, covariance=covariance)
-    c = tuple_costs(scan, g, method, normalisation=normalisation)
-    keep = np.isfinite(c.total)
-    return AssignmentProblem.sparse(scan.sizes, T[keep], c.total[keep], name=name)
+    c = tuple_costs_in_chunks(scan, T, method, localiser=localiser, covariance=covariance,
+                              normalisation=normalisation)
+    keep = np.isfinite(c)
+    return AssignmentProblem.sparse(scan.sizes, T[keep], c[keep], name=name)
