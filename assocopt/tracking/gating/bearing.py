@@ -57,13 +57,14 @@ def bearing_pair_gate(scan: Scan, *, probability: float = 0.99,
       ``beta_j`` lies in the arc of bearings, seen from ``t``, of the points of
       ``i``'s sight ray (up to ``max_range``); the arcs are windows on ``t``'s
       sorted bearings;
-    * in space (with ``probability < 1``), the residual test bounds each angle's
-      error (``|d alpha| <= sqrt(gamma R_aa)``, ``|d beta| <= sqrt(gamma R_bb)``),
-      so the estimated position's direction lies within a cone of half-angle
-      ``eps`` around each line of sight; both directions lie in one plane through
-      the two sensors (an epipolar plane), so the planes' angles ``psi`` about the
-      baseline, within ``arcsin(sin eps / sin theta)`` of each line's (``theta``
-      its angle to the baseline), must overlap: a window test on sorted angles.
+    * in space (with ``probability < 1``), the residual test bounds the angle
+      errors of both measurements together (``q_s + q_t <= gamma``), so the
+      estimated position's direction from each sensor lies in a cone around its
+      line of sight; both directions lie in one plane through the two sensors (an
+      epipolar plane), so the lines' own epipolar angles ``psi`` about the baseline
+      can differ by at most a bound that follows from the cones and the
+      lines' angles to the baseline: a window test on sorted angles.  Without the
+      residual test (``probability=1``) every pair is tested.
     """
     from scipy import sparse
 
