@@ -80,7 +80,8 @@ def draw_scan(spec: ScanSpec) -> list[np.ndarray]:
 def pair_gate(spec: ScanSpec, meas: list[np.ndarray]) -> dict[tuple[int, int], np.ndarray]:
     """Compatible measurement pairs of every sensor pair: the chi-square gate on
     ``z_s - z_t`` (covariance ``2 sigma^2 I``, so the Mahalanobis test is a distance
-    test: ``|z_s - z_t| <= gate_radius``), by KD-trees."""
+    test: ``|z_s - z_t| <= gate_radius``), by KD-trees; each pair's compatible
+    ``(i, j)`` as an ``(m, 2)`` index array (no ``n_s x n_t`` matrix)."""
     from scipy.spatial import cKDTree
     N = spec.N
     trees = [cKDTree(z) for z in meas]
@@ -89,9 +90,7 @@ def pair_gate(spec: ScanSpec, meas: list[np.ndarray]) -> dict[tuple[int, int], n
         for t in range(s + 1, N):
             D = trees[s].sparse_distance_matrix(trees[t], spec.gate_radius,
                                                 output_type="ndarray")
-            M = np.zeros((len(meas[s]), len(meas[t])), dtype=bool)
-            M[D["i"], D["j"]] = True
-            ok[(s, t)] = M
+            ok[(s, t)] = np.stack([D["i"], D["j"]], axis=1).astype(np.int64)
     return ok
 
 

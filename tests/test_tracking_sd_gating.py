@@ -81,9 +81,9 @@ def test_behind_and_max_range_gates_in_the_plane():
     # the second measurement of sensor 1 points away (-45 deg): its lines meet behind it
     meas = [np.array([np.pi / 4]), np.array([3 * np.pi / 4, -np.pi / 4])]
     scan = Scan.create(S, meas, 1e-6)
-    ok = bearing_pair_gate(scan)[(0, 1)]
+    ok = bearing_pair_gate(scan)[(0, 1)].toarray()
     assert ok.tolist() == [[True, False]]
-    assert bearing_pair_gate(scan, max_range=5.0)[(0, 1)].tolist() == [[False, False]]
+    assert bearing_pair_gate(scan, max_range=5.0)[(0, 1)].toarray().tolist() == [[False, False]]
 
 
 def test_thirty_targets_five_sensors_without_enumerating_every_tuple():
@@ -100,3 +100,136 @@ def test_bad_compatibility_is_named():
         gated_tuples((2, 2), {(0, 1): np.ones((3, 2), bool)}, 1.0)
     with pytest.raises(InvalidProblemError, match="must be a sensor pair"):
         gated_tuples((2, 2), {(1, 0): np.ones((2, 2), bool)}, 1.0)
+
+
+def _forms(M: np.ndarray, rng) -> list:
+    """One compatibility matrix in every form gated_tuples accepts."""
+    from scipy import sparse
+    i, j = np.nonzero(M)
+    pairs = np.stack([i, j], axis=1).astype(np.int64)
+    dup = pairs[rng.integers(0, len(pairs), size=len(pairs) // 2)] if len(pairs) else pairs
+    coo = sparse.coo_matrix((np.ones(len(i), bool), (i, j)), shape=M.shape)
+    return [sparse.csr_matrix(M), sparse.csc_array(M), coo,
+            np.concatenate([pairs, dup])[rng.permutation(len(pairs) + len(dup))]]
+
+
+@given(st.integers(0, 10_000), st.integers(2, 4), st.booleans(), st.booleans())
+def test_sparse_and_index_pair_forms_give_the_dense_result(seed, N, miss, clutter):
+    rng = np.random.default_rng(seed)
+    sizes = tuple(int(v) for v in rng.integers(0, 5, size=N))
+    pd = np.where(rng.random(N) < 0.5, 1.0, 0.8) if miss else np.ones(N)
+    cd = rng.choice([0.0, 0.5], size=N) if clutter else np.zeros(N)
+    ok = {(s, t): rng.random((sizes[s], sizes[t])) < 0.4
+          for s, t in itertools.combinations(range(N), 2) if rng.random() < 0.8}
+    want = gated_tuples(sizes, ok, pd, cd)
+    per_key = {k: _forms(M, rng) for k, M in ok.items()}
+    for f in range(4):
+        got = gated_tuples(sizes, {k: v[f] for k, v in per_key.items()}, pd, cd)
+        assert np.array_equal(got, want), f
+    mixed = {k: v[int(rng.integers(0, 4))] for k, v in per_key.items()}
+    assert np.array_equal(gated_tuples(sizes, mixed, pd, cd), want)
+
+
+def test_sparse_gates_never_allocate_the_pair_matrices():
+    """20 000 measurements a sensor: a dense compatibility matrix would take 400 MB."""
+    import tracemalloc
+    from scipy import sparse
+    n = 20_000
+    rng = np.random.default_rng(0)
+    perm = [rng.permutation(n) for _ in range(3)]
+    eye = {(s, t): sparse.csr_matrix((np.ones(n, bool), (perm[s], perm[t])), shape=(n, n))
+           for s, t in itertools.combinations(range(3), 2)}
+    tracemalloc.start()
+    T = gated_tuples((n, n, n), eye, 0.9)
+    peak = tracemalloc.get_traced_memory()[1]
+    tracemalloc.stop()
+    assert peak < 60e6
+    full = T[(T > 0).all(axis=1)]
+    assert len(full) == n and len(T) == 7 * n       # triples, three pair kinds, singles
+    assert (perm[1][np.argsort(perm[0])][full[:, 0] - 1] == full[:, 1] - 1).all()
+
+
+def test_bad_index_pairs_are_named():
+    with pytest.raises(InvalidProblemError, match=r"index pairs must lie in"):
+        gated_tuples((2, 2), {(0, 1): np.array([[0, 2]])}, 1.0)
+    with pytest.raises(InvalidProblemError, match=r"must have shape"):
+        from scipy import sparse
+        gated_tuples((2, 2), {(0, 1): sparse.csr_matrix((3, 2), dtype=bool)}, 1.0)
+
+
+def _same_gate(scan, **kw):
+    fast = bearing_pair_gate(scan, **kw)
+    slow = bearing_pair_gate(scan, prefilter=False, **kw)
+    assert set(fast) == set(slow)
+    for k in slow:
+        assert np.array_equal(fast[k].toarray(), slow[k].toarray()), k
+    return slow
+
+
+@pytest.mark.parametrize("seed", range(6))
+def test_prefiltered_bearing_gate_equals_the_all_pairs_test_in_space(seed):
+    rng = np.random.default_rng(seed)
+    n = int(rng.integers(3, 12))
+    sc = Lu2013(n_targets=n, d=float(rng.choice([0.5, 2.0])), sensors_km=FIVE[:3 + seed % 3],
+                pd=float(rng.choice([1.0, 0.8])), clutter_rate=float(rng.choice([0.0, 2.0])),
+                sigma_mrad=float(rng.choice([1.5, 5.0])))
+    scan, _ = sc.simulate(rng)
+    for p in (0.9, 0.99, 0.9999):
+        slow = _same_gate(scan, probability=p)
+        assert any(M.nnz for M in slow.values())
+    _same_gate(scan, probability=0.99, max_range=30.0)
+    _same_gate(scan, probability=1.0)                      # no residual test: all pairs
+
+
+@pytest.mark.parametrize("seed", range(6))
+def test_prefiltered_bearing_gate_equals_the_all_pairs_test_in_the_plane(seed):
+    from assocopt.tracking.costs.sd_builder import Scan
+    rng = np.random.default_rng(seed)
+    S = rng.uniform(-20, 20, size=(int(rng.integers(2, 5)), 2))
+    X = rng.uniform(-30, 30, size=(int(rng.integers(2, 15)), 2))
+    meas = [np.arctan2(X[:, 1] - p[1], X[:, 0] - p[0]) + rng.normal(0, 1e-3, len(X))
+            for p in S]
+    meas = [np.concatenate([m, rng.uniform(-np.pi, np.pi, 3)]) for m in meas]
+    scan = Scan.create(S, meas, 1e-6)
+    slow = _same_gate(scan)
+    assert any(M.nnz for M in slow.values()) and not all(
+        M.nnz == M.shape[0] * M.shape[1] for M in slow.values())
+    for r in (5.0, 20.0, 60.0):
+        _same_gate(scan, max_range=r)
+
+
+def _volume_scan(n, seed, sigma=1.5e-3):
+    """Targets spread through a volume, three sensors at different heights."""
+    from assocopt.tracking.costs.sd_builder import Scan
+    rng = np.random.default_rng(seed)
+    S = np.array([[0.0, 0.0, 0.0], [60.0, 0.0, 0.5], [30.0, -50.0, 1.0]])
+    X = np.column_stack([rng.uniform(-100, 150, n), rng.uniform(40, 200, n),
+                         rng.uniform(1, 15, n)])
+    th = angles(X, S)
+    meas = [th[rng.permutation(n), s] + rng.normal(0, sigma, (n, 2)) for s in range(3)]
+    return Scan.create(S, meas, np.eye(2) * sigma ** 2)
+
+
+@pytest.mark.parametrize("seed", range(2))
+def test_prefilter_keeps_few_more_than_the_exact_test(seed):
+    scan = _volume_scan(120, seed)
+    from assocopt.tracking.gating import bearing as bg
+    slow = _same_gate(scan, probability=0.99)
+    for (s, t), M in slow.items():
+        cand = len(bg._epipolar_candidates(scan, s, t, bg.chi2_threshold(0.99, 1))[0])
+        assert M.nnz <= cand < 2 * M.nnz + 50
+        assert cand < 0.3 * 120 * 120
+
+
+@pytest.mark.parametrize("method", ["pattipati", "skld-exact", "pattipati-ml"])
+def test_costs_in_chunks_equal_the_costs_of_all_tuples(method):
+    from assocopt.tracking.costs.sd_builder import tuple_costs_in_chunks
+    from assocopt.tracking.costs.sd_builder import COST_LOCALISER
+    sc = Lu2013(n_targets=5, d=2.0, sensors_km=FIVE[:3], pd=0.8, clutter_rate=1.0)
+    scan, _ = sc.simulate(np.random.default_rng(2))
+    T = candidate_tuples(scan.sizes, scan.pd, scan.clutter_density)
+    g = tuple_geometry(scan, T, localiser=COST_LOCALISER.get(method, "ls"))
+    want = tuple_costs(scan, g, method).total
+    got = tuple_costs_in_chunks(scan, T, method, chunk=17)
+    assert np.array_equal(np.isinf(got), np.isinf(want))
+    assert got[np.isfinite(want)] == pytest.approx(want[np.isfinite(want)], rel=1e-12)

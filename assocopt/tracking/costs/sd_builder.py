@@ -34,7 +34,8 @@ from .data_terms import TupleGeometry, data_term
 from .pattipati import NORMALISATIONS, constant_terms
 
 __all__ = ["Scan", "COSTS", "PRINTED_COSTS", "candidate_tuples", "TupleGeometry",
-           "tuple_geometry", "SDCosts", "tuple_costs", "build_costs", "build_problem"]
+           "tuple_geometry", "SDCosts", "tuple_costs", "tuple_costs_in_chunks", "build_costs",
+           "build_problem"]
 
 #: The named cost builders: name -> what it is.  "printed" = exactly as printed in
 #: paper 002 (not true divergences); "exact" = the exact 1-D Gaussian forms with the
@@ -283,6 +284,23 @@ def tuple_costs(scan: Scan, geometry: TupleGeometry, method: str, *,
     total = const + data
     return SDCosts(method, g.tuples, total, data, const,
                    {"normalisation": normalisation, **g.options})
+
+
+def tuple_costs_in_chunks(scan: Scan, tuples: np.ndarray, method: str = "pattipati", *,
+                          localiser: str = "ls", covariance: str = "residual",
+                          normalisation: str = "printed", chunk: int = 1 << 16
+                          ) -> np.ndarray:
+    """Total cost of every tuple (``+inf``: forbidden), its geometry built ``chunk``
+    tuples at a time: the same numbers as :func:`tuple_geometry` and
+    :func:`tuple_costs` on all of them, in memory bounded by the chunk (a tuple's
+    geometry takes about 1 KB) rather than by the number of tuples."""
+    T = np.asarray(tuples, dtype=np.int64)
+    out = np.empty(len(T))
+    loc = COST_LOCALISER.get(method, localiser)
+    for a in range(0, len(T), chunk):
+        g = tuple_geometry(scan, T[a:a + chunk], localiser=loc, covariance=covariance)
+        out[a:a + chunk] = tuple_costs(scan, g, method, normalisation=normalisation).total
+    return out
 
 
 def _constants(scan: Scan, g: TupleGeometry, normalisation: str) -> np.ndarray:

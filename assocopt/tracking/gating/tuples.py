@@ -20,27 +20,42 @@ when its measurement may be a false alarm or every other sensor may miss.
 
 from __future__ import annotations
 
-from typing import Mapping, Sequence
+from typing import Any, Mapping, Sequence
 
 import numpy as np
 from numpy.typing import ArrayLike
 
 from ...runtime.errors import InvalidProblemError
 
-__all__ = ["gated_tuples", "PairGate"]
+__all__ = ["gated_tuples", "PairGate", "pair_lists"]
 
-PairGate = Mapping[tuple[int, int], np.ndarray]
+#: A sensor pair's compatibility: a boolean ``(n_s, n_t)`` matrix (dense numpy or
+#: scipy sparse) or an ``(m, 2)`` integer array of compatible ``(i, j)`` (0-based).
+PairGate = Mapping[tuple[int, int], Any]
 
 
 def gated_tuples(sizes: Sequence[int], compatible: PairGate, pd: ArrayLike,
                  clutter_density: ArrayLike | None = None) -> np.ndarray:
     """Candidate tuples (0 = dummy) whose real measurements are pairwise compatible.
 
-    ``compatible[(s, t)]`` (``s < t``) is a boolean ``(n_s, n_t)`` matrix; a sensor
-    pair that is absent is fully compatible.  Rows are sorted lexicographically.
+    ``compatible[(s, t)]`` (``s < t``) is, in any of three forms, which measurement
+    pairs of sensors ``s`` and ``t`` may come from one target:
+
+    * a boolean numpy ``(n_s, n_t)`` matrix (a numeric matrix of that shape is read
+      as its non-zeros, unless it is an integer array of two columns);
+    * a scipy sparse ``(n_s, n_t)`` matrix or array (its stored non-zero entries);
+    * an ``(m, 2)`` integer array of compatible pairs ``(i, j)``, 0-based
+      (duplicates allowed).
+
+    A sensor pair that is absent is fully compatible.  Internally every form
+    becomes sorted CSR lists: nothing of size ``n_s x n_t`` is allocated, and the
+    tuples are built in bulk (arrays of partial tuples, no Python loop per tuple).
+    Rows are sorted lexicographically.
 
     >>> ok = {(0, 1): np.array([[True, False], [False, True]])}
     >>> gated_tuples((2, 2), ok, [1.0, 1.0]).tolist()
+    [[1, 1], [2, 2]]
+    >>> gated_tuples((2, 2), {(0, 1): np.array([[0, 0], [1, 1]])}, [1.0, 1.0]).tolist()
     [[1, 1], [2, 2]]
     """
     sizes = tuple(int(n) for n in sizes)
@@ -61,7 +76,7 @@ def gated_tuples(sizes: Sequence[int], compatible: PairGate, pd: ArrayLike,
             if pairs[(t, s)] is not None:      # a dummy in t is compatible with all
                 i = partial[k, t]
                 m = np.flatnonzero(i > 0)
-                keep[m] &= pairs[(t, s)][0][i[m] - 1, j[m] - 1]
+                keep[m] &= _member(pairs[(t, s)], i[m] - 1, j[m] - 1)
         k, j = k[keep], j[keep]
         if may_miss[s]:
             k = np.concatenate([np.arange(len(partial)), k])
@@ -93,7 +108,7 @@ def _extensions(partial: np.ndarray, s: int, n_s: int, pairs) -> tuple[np.ndarra
         sel = np.flatnonzero(anchor == t)
         if pairs[(t, s)] is None or not len(sel):
             continue
-        _, ptr, cols = pairs[(t, s)]
+        ptr, cols = pairs[(t, s)][:2]
         r = partial[sel, t] - 1
         cnt = ptr[r + 1] - ptr[r]
         first = np.repeat(ptr[r] - (np.cumsum(cnt) - cnt), cnt)
@@ -102,9 +117,58 @@ def _extensions(partial: np.ndarray, s: int, n_s: int, pairs) -> tuple[np.ndarra
     return np.concatenate(ks).astype(np.int64), np.concatenate(js).astype(np.int64)
 
 
+def _member(pair, i: np.ndarray, j: np.ndarray) -> np.ndarray:
+    """Whether each ``(i[k], j[k])`` (0-based) is a compatible pair: a binary search
+    in the pair's sorted keys ``i * n_t + j``."""
+    keys, n_t = pair[2], pair[3]
+    q = i * n_t + j
+    if not len(keys):
+        return np.zeros(len(q), bool)
+    pos = np.minimum(np.searchsorted(keys, q), len(keys) - 1)
+    return keys[pos] == q
+
+
+def pair_lists(M: Any, shape: tuple[int, int], what: str = "compatibility"
+               ) -> tuple[np.ndarray, np.ndarray]:
+    """The compatible pairs of one sensor pair as sorted, distinct 0-based
+    ``(rows, cols)`` (by row, then column), from any form :func:`gated_tuples`
+    accepts; never allocates ``shape`` unless ``M`` is a dense matrix already."""
+    n_s, n_t = shape
+    if hasattr(M, "tocoo") and hasattr(M, "nnz"):            # scipy sparse
+        if tuple(M.shape) != shape:
+            raise InvalidProblemError(f"{what} must have shape {shape}, got {tuple(M.shape)}")
+        C = M.tocoo()
+        nz = np.asarray(C.data) != 0
+        r = np.asarray(C.row, np.int64)[nz]
+        c = np.asarray(C.col, np.int64)[nz]
+    else:
+        A = np.asarray(M)
+        pairs_form = A.ndim == 2 and A.shape[1] == 2 and A.dtype != bool and (
+            np.issubdtype(A.dtype, np.integer) or A.shape != shape) and A.size > 0
+        if A.ndim == 2 and A.shape == (0, 2) and A.dtype != bool and shape != (0, 2):
+            pairs_form = True                                  # no pair at all
+        if pairs_form:
+            if not np.issubdtype(A.dtype, np.integer):
+                raise InvalidProblemError(f"{what}: an index-pair array must hold integers, "
+                                          f"got {A.dtype}")
+            r, c = A[:, 0].astype(np.int64), A[:, 1].astype(np.int64)
+            if len(r) and (r.min() < 0 or r.max() >= n_s or c.min() < 0 or c.max() >= n_t):
+                raise InvalidProblemError(
+                    f"{what}: index pairs must lie in [0, {n_s}) x [0, {n_t}) (0-based)")
+        else:
+            if A.shape != shape:
+                raise InvalidProblemError(f"{what} must have shape {shape}, got {A.shape}")
+            flat = np.flatnonzero(np.asarray(A, dtype=bool))
+            r, c = np.divmod(flat.astype(np.int64), max(n_t, 1))
+            return r, c                                        # sorted and distinct
+    keys = np.unique(r * n_t + c)
+    return np.divmod(keys, max(n_t, 1))
+
+
 def _pairs(sizes, compatible) -> dict:
-    """For every sensor pair ``(s, t)``: None (not gated: all compatible), or the
-    boolean matrix with its CSR lists ``(M, ptr, cols)`` (0-based, real indices)."""
+    """For every sensor pair ``(s, t)``: None (not gated: all compatible), or its
+    CSR lists ``(ptr, cols, keys, n_t)`` (0-based, real indices; ``keys`` the
+    sorted ``i * n_t + j`` of the compatible pairs, for membership tests)."""
     N = len(sizes)
     for key in compatible:
         if not (isinstance(key, tuple) and len(key) == 2 and
@@ -118,16 +182,11 @@ def _pairs(sizes, compatible) -> dict:
             if (s, t) not in compatible:
                 out[(s, t)] = None
                 continue
-            M = np.ascontiguousarray(compatible[(s, t)], dtype=bool)
-            if M.shape != (sizes[s], sizes[t]):
-                raise InvalidProblemError(
-                    f"compatibility of sensors ({s}, {t}) must have shape "
-                    f"({sizes[s]}, {sizes[t]}), got {M.shape}")
-            flat = np.flatnonzero(M)
+            r, c = pair_lists(compatible[(s, t)], (sizes[s], sizes[t]),
+                              f"compatibility of sensors ({s}, {t})")
             ptr = np.zeros(sizes[s] + 1, np.int64)
-            np.cumsum(np.bincount(flat // max(sizes[t], 1), minlength=sizes[s]),
-                      out=ptr[1:])
-            out[(s, t)] = (M, ptr, flat % max(sizes[t], 1))
+            np.cumsum(np.bincount(r, minlength=sizes[s]), out=ptr[1:])
+            out[(s, t)] = (ptr, c, r * sizes[t] + c, sizes[t])
     return out
 
 
