@@ -311,3 +311,28 @@ def test_same_tracks_as_jpda_with_ehm2_in_the_mixture_tracker(seed):
             np.testing.assert_allclose(sa.covar, sb.covar, rtol=0, atol=1e-9)
             updates += hasattr(sa, "hypothesis")
     assert updates > 10                            # detections were used
+
+
+@pytest.mark.parametrize("dense", [True, False])
+def test_the_whole_scan_path_maps_the_marginals_back(monkeypatch, dense):
+    """The path taken when marginals has method="exact" (one call on the whole scan),
+    run here with an exhaustive ranking standing in for it where it is not installed."""
+    scan = entangled_scan(np.random.default_rng(11), n_clusters=2, cluster_size=3)
+    cached = Cached()
+    cached.table = _hypotheses(scan)
+    ref = JPDAwithEHM2(cached).associate(set(scan.tracks), scan.detections, scan.timestamp)
+    pp = probability_problem(cached.table, dense=dense)
+    calls = []
+
+    def stand_in(problem, method):
+        calls.append(method)
+        if method == jpda_mod.EXACT_METHOD:
+            return assocopt.marginals(problem, method=method)
+        m = assocopt.marginals(problem, k=10**5, method="kbest")
+        assert m.exhaustive
+        return m
+
+    monkeypatch.setattr(jpda_mod, "marginals", stand_in)
+    P = jpda_mod.association_probabilities(pp, "exact")
+    assert calls == ["exact"]
+    _same_posterior(pp.posterior(P), ref)
