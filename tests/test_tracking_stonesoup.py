@@ -119,7 +119,8 @@ def test_problem_from_hypotheses_has_the_miss_candidates():
 
 
 @pytest.mark.parametrize("module", ["stonesoup", "stonesoup.associators",
-                                    "stonesoup.hypothesiser", "stonesoup.scenario"])
+                                    "stonesoup.hypothesiser", "stonesoup.scenario",
+                                    "stonesoup.jpda", "stonesoup.problems"])
 def test_missing_stonesoup_names_the_extra(module):
     code = ("import sys; sys.modules['stonesoup'] = None\n"
             f"try:\n    import assocopt.tracking.{module}\n"

@@ -27,8 +27,6 @@ Tracks without any hypothesis are left out of the association, as in Stone Soup.
 
 from __future__ import annotations
 
-import math
-
 import numpy as np
 
 try:
@@ -45,6 +43,7 @@ except ImportError as exc:  # pragma: no cover - exercised in a subprocess-free 
 from ...solving.api import solve
 from ...problems.problem import AssignmentProblem
 from ...model.solution import Status
+from .problems import hypothesis_table, use_dense
 
 __all__ = ["AssocoptGNN", "AssocoptKBest", "AssocoptMFA", "hypotheses_problem",
            "mfa_reference_cost"]
@@ -53,14 +52,22 @@ __all__ = ["AssocoptGNN", "AssocoptKBest", "AssocoptMFA", "hypotheses_problem",
 PROBABILITY_SCORES = ("linear", "log")
 
 
-def hypotheses_problem(hypotheses, probability_score: str = "linear"):
-    """The 2-D problem of a hypothesiser's output (module docstring).
+def hypotheses_problem(hypotheses, probability_score: str = "linear", *,
+                       dense: bool | None = None):
+    """The 2-D problem of a hypothesiser's output (module docstring), built in bulk.
+
+    Each hypothesis is read once (:func:`~.problems.hypothesis_table`); costs,
+    checks and the candidate list are numpy.
 
     Parameters
     ----------
     hypotheses : mapping track -> iterable of SingleHypothesis
         What ``DataAssociator.generate_hypotheses`` returns.
     probability_score : "linear" or "log"
+    dense : bool, optional
+        Keep the problem as a matrix (the 2-D engines' fast path: Murty's k best
+        prices its answers in bulk there) or a candidate list; by default
+        :func:`~.problems.use_dense` decides from the sizes.
 
     Returns
     -------
@@ -71,48 +78,55 @@ def hypotheses_problem(hypotheses, probability_score: str = "linear"):
     if probability_score not in PROBABILITY_SCORES:
         raise ValueError(f"probability_score must be one of {PROBABILITY_SCORES}, "
                          f"got {probability_score!r}")
-    tracks = [t for t, hyps in hypotheses.items() if hyps]
-    det_index: dict = {}
-    table: dict[tuple[int, int], object] = {}
-    rows, cols, costs = [], [], []
+    t = hypothesis_table(hypotheses)
     kinds = set()
-    for i, track in enumerate(tracks, start=1):
-        for hyp in hypotheses[track]:
-            if isinstance(hyp, SingleProbabilityHypothesis):
-                kinds.add("probability")
-                p = hyp.probability
-                log_p = float(getattr(p, "log_value", math.log(float(p)) if float(p) > 0
-                                      else -math.inf))
-                cost = -float(p) if probability_score == "linear" else -log_p
-            elif isinstance(hyp, SingleDistanceHypothesis):
-                kinds.add("distance")
-                cost = float(hyp.distance)
-            else:
-                raise TypeError(f"hypothesis of type {type(hyp).__name__} has neither a "
-                                "distance nor a probability")
-            j = det_index.setdefault(hyp.measurement, len(det_index) + 1) if hyp else 0
-            if (i, j) in table:
-                raise ValueError(f"track {i - 1} has two hypotheses for "
-                                 f"{'a missed detection' if j == 0 else 'one detection'}")
-            table[(i, j)] = hyp
-            rows.append(i)
-            cols.append(j)
-            costs.append(cost)
+    for kind in {type(h) for h in t.hypotheses}:
+        if issubclass(kind, SingleProbabilityHypothesis):
+            kinds.add("probability")
+        elif issubclass(kind, SingleDistanceHypothesis):
+            kinds.add("distance")
+        else:
+            raise TypeError(f"hypothesis of type {kind.__name__} has neither a "
+                            "distance nor a probability")
     if len(kinds) > 1:
         raise RuntimeError("2d assignment does not support mixed hypothesis types")
-    free = np.arange(1, len(det_index) + 1)
-    tuples = np.concatenate([np.stack([np.asarray(rows, np.int64), np.asarray(cols, np.int64)],
-                                      axis=1).reshape(-1, 2),
-                             np.stack([np.zeros_like(free), free], axis=1)])
-    c = np.concatenate([np.asarray(costs, np.float64), np.zeros(len(free))])
-    problem = AssignmentProblem.sparse((len(tracks), len(det_index)), tuples, c,
-                                       name="stonesoup-hypotheses")
-    return problem, tracks, table
+    if kinds == {"distance"}:
+        cost = np.fromiter((h.distance for h in t.hypotheses), np.float64,
+                           len(t.hypotheses))
+    else:
+        log_p = t.log_probabilities()
+        cost = -np.exp(log_p) if probability_score == "linear" else -log_p
+    n, m = t.shape
+    miss = t.col < 0
+    if dense is None:
+        dense = use_dense(n, m, len(cost))
+    if dense:
+        C = np.full((n, m), np.inf)
+        C[t.row[~miss], t.col[~miss]] = cost[~miss]
+        rm = np.full(n, np.inf)
+        rm[t.row[miss]] = cost[miss]
+        problem = AssignmentProblem.two_d(C, rm, 0.0, name="stonesoup-hypotheses")
+    else:
+        tuples = np.zeros((len(cost) + m, 2), np.int64)
+        tuples[:len(cost), 0] = t.row + 1
+        tuples[:len(cost), 1] = t.col + 1            # the miss: column 0
+        tuples[len(cost):, 1] = np.arange(1, m + 1)
+        problem = AssignmentProblem.sparse((n, m), tuples, np.concatenate(
+            [cost, np.zeros(m)]), name="stonesoup-hypotheses")
+    table = dict(zip(zip((t.row + 1).tolist(), (t.col + 1).tolist()), t.hypotheses))
+    return problem, t.tracks, table
 
 
 def _joint(tuples: np.ndarray, tracks: list, table: dict) -> JointHypothesis:
     chosen = {tracks[i - 1]: table[(i, j)] for i, j in tuples.tolist() if i > 0}
     return JointHypothesis(chosen)
+
+
+def _fits_dense(hypotheses) -> bool | None:
+    """Dense for the ranking (the compiled 2-D ranking forms the matrix anyway) unless
+    the matrix would be huge; None: :func:`~.problems.use_dense` decides."""
+    n = sum(1 for h in hypotheses.values() if len(h))
+    return True if n * (sum(len(h) for h in hypotheses.values()) + 1) <= 1 << 22 else None
 
 
 class AssocoptGNN(DataAssociator):
@@ -203,7 +217,8 @@ class AssocoptKBest(Base):
 
         if isinstance(self.k, bool) or int(self.k) != self.k or self.k < 1:
             raise ValueError(f"k must be a positive integer, got {self.k!r}")
-        problem, tracks, table = hypotheses_problem(hypotheses, self.probability_score)
+        problem, tracks, table = hypotheses_problem(hypotheses, self.probability_score,
+                                                    dense=_fits_dense(hypotheses))
         self.last_ranked = kbest(problem, int(self.k), solver=self.solver,
                                  **(self.solver_options or {}))
         return [_joint(s.tuples, tracks, table) for s in self.last_ranked]

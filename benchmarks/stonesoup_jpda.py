@@ -1,0 +1,182 @@
+"""Benchmark: assocopt's Stone Soup JPDA (AssocoptJPDA) beside Stone Soup's JPDAwithEHM2.
+
+Scenes of :func:`assocopt.tracking.stonesoup.scenario.entangled_scan` (Stone Soup's
+constant-velocity and linear-Gaussian models, PDAHypothesiser with known clutter
+density, P_D = 0.9): clusters of ``size`` tracks 2 m apart on a square grid, 1 km
+apart from each other, with clutter.  Per scan the hypotheses are generated once and
+served from a cache to both associators (hypothesis generation is the same Stone Soup
+code for both and would dominate), and the CPU time (``time.process_time``, one
+process, side by side) of each ``associate`` call is measured, best of ``--repeat``;
+the largest difference between the two associators' probabilities is recorded.
+
+Which engine ours ran is recorded too: ``marginals(method="exact")`` where assocopt has
+it, else the per-cluster exhaustive ranking of ``assocopt.tracking.stonesoup.jpda``
+(which refuses a cluster with more than 2^20 joint associations; such a scene is
+recorded as refused, not timed).
+
+Usage::
+
+    python benchmarks/stonesoup_jpda.py [--configs 3x8,5x5,8x2,4x25] [--scans 3]
+        [--repeat 3] [--seed 0] [--out docs/benchmarks-jpda]
+
+``SIZExCLUSTERS``: tracks per cluster x clusters per scene.  Writes ``OUT.json`` and
+``OUT.md``.
+"""
+
+from __future__ import annotations
+
+import argparse
+import os
+import statistics
+import sys
+import time
+from pathlib import Path
+
+import numpy as np
+
+ROOT = Path(__file__).resolve().parents[1]
+sys.path.insert(0, str(ROOT))
+sys.path.insert(0, str(ROOT / "benchmarks"))
+
+from stonesoup_assoc import command, machine, write_pages  # noqa: E402
+
+DEFAULT_CONFIGS = "3x8,5x5,8x2,4x25"
+#: Scene parameters of every config (entangled_scan's arguments).
+SPACING, CLUTTER = 2.0, 3.0
+
+
+def _cpu_best(call, repeat: int):
+    """``(result, best CPU seconds of repeat calls)``."""
+    best = float("inf")
+    out = None
+    for _ in range(repeat):
+        t0 = time.process_time()
+        out = call()
+        best = min(best, time.process_time() - t0)
+    return out, best
+
+
+def run_config(size: int, clusters: int, scans: int, seed: int, repeat: int) -> dict:
+    from stonesoup.dataassociator.probability import JPDAwithEHM2
+    from stonesoup.hypothesiser import Hypothesiser
+
+    from assocopt import ProblemTooLargeError
+    from assocopt.tracking.stonesoup import AssocoptJPDA
+    from assocopt.tracking.stonesoup.scenario import entangled_scan
+
+    class Cached(Hypothesiser):
+        """Serves the hypotheses computed for this scan."""
+
+        def hypothesise(self, track, detections, timestamp, **kwargs):
+            return self.table[track]
+
+    cached = Cached()
+    ours, ref = AssocoptJPDA(cached), JPDAwithEHM2(cached)
+    t_ours, t_ref, errors, n_hyp, n_det = [], [], [], [], []
+    refused = 0
+    for s in range(scans):
+        scan = entangled_scan(np.random.default_rng([seed, size, clusters, s]),
+                              n_clusters=clusters, cluster_size=size, spacing=SPACING,
+                              clutter_rate=CLUTTER)
+        hyp = scan.hypothesiser()
+        cached.table = {tr: hyp.hypothesise(tr, scan.detections, scan.timestamp)
+                        for tr in scan.tracks}
+        n_hyp.append(sum(len(h) for h in cached.table.values()))
+        n_det.append(len(scan.detections))
+        args = (set(scan.tracks), scan.detections, scan.timestamp)
+        b, dt = _cpu_best(lambda: ref.associate(*args), repeat)
+        t_ref.append(dt)
+        try:
+            a, dt = _cpu_best(lambda: ours.associate(*args), repeat)
+        except ProblemTooLargeError:
+            refused += 1
+            continue
+        t_ours.append(dt)
+        errors.append(max(abs(float(x.probability) - float(y.probability))
+                          for tr in b for x, y in zip(a[tr], b[tr])))
+    ours_s = statistics.median(t_ours) if t_ours else None
+    ref_s = statistics.median(t_ref)
+    return {"cluster_size": size, "clusters": clusters, "tracks": size * clusters,
+            "scans": scans, "detections_per_scan": float(np.mean(n_det)),
+            "hypotheses_per_scan": float(np.mean(n_hyp)),
+            "assocopt_cpu_s": ours_s, "ehm2_cpu_s": ref_s,
+            "speedup": ref_s / ours_s if ours_s else None,
+            "max_error": max(errors) if errors else None, "refused_scans": refused}
+
+
+def render(result: dict) -> str:
+    """The markdown page of a result (tests/test_benchmarks_jpda.py checks it)."""
+    m = result["machine"]
+    engine = {"exact": "`assocopt.marginals(method=\"exact\")` on the whole scan",
+              None: "the per-cluster exhaustive ranking of `assocopt.tracking.stonesoup."
+                    "jpda` (no exact marginals engine installed: it sums every joint "
+                    "association of each cluster, so its time grows with their number)"}
+    lines = [
+        "# Stone Soup JPDA: AssocoptJPDA beside JPDAwithEHM2",
+        "",
+        f"Generated by `{result['command']}`.  Per scan, the median over "
+        f"{result['scans']} scans of the best of {result['repeat']} CPU times "
+        "(`time.process_time`, both associators side by side in one process) of one "
+        "`associate` call, both given the same cached `PDAHypothesiser` hypotheses.  "
+        f"Scenes: clusters of tracks {result['spacing']:g} m apart on a square grid "
+        "(entangled: each track's gate holds its neighbours' detections), clusters "
+        f"1 km apart, P_D = 0.9, {result['clutter_rate']:g} false alarms per cluster "
+        "on average (see the script's docstring).  "
+        "max error: the largest difference between the two associators' "
+        "probabilities over all scans.",
+        "",
+        f"assocopt's engine in this run: {engine[result['engine']]}.",
+        "",
+        f"Machine: {m['cpu_count']} logical cores, {m['platform']}; Python {m['python']}, "
+        f"numpy {m['numpy']}, stonesoup {m['stonesoup']}; load average "
+        f"{m['load_start']} at start, {m['load_end']} at end (the cores are shared).",
+        "",
+        "| tracks per cluster | clusters | detections / scan | hypotheses / scan | "
+        "AssocoptJPDA CPU s | JPDAwithEHM2 CPU s | speed-up | max error |",
+        "|---|---|---|---|---|---|---|---|",
+    ]
+    for r in result["rows"]:
+        if r["assocopt_cpu_s"] is None:
+            ours, speed, err = "refused", "-", "-"
+        else:
+            ours, speed = f"{r['assocopt_cpu_s']:.4f}", f"{r['speedup']:.2f}"
+            err = f"{r['max_error']:.1e}"
+        if r["refused_scans"] and r["assocopt_cpu_s"] is not None:
+            ours += f" ({r['refused_scans']} of {r['scans']} scans refused)"
+        lines.append(f"| {r['cluster_size']} | {r['clusters']} | "
+                     f"{r['detections_per_scan']:.1f} | {r['hypotheses_per_scan']:.1f} | "
+                     f"{ours} | {r['ehm2_cpu_s']:.4f} | {speed} | {err} |")
+    lines += ["", "speed-up = JPDAwithEHM2 / AssocoptJPDA (above 1: assocopt is faster).",
+              ""]
+    return "\n".join(lines)
+
+
+def main(argv=None) -> dict:
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--configs", default=DEFAULT_CONFIGS)
+    ap.add_argument("--scans", type=int, default=3)
+    ap.add_argument("--seed", type=int, default=0)
+    ap.add_argument("--repeat", type=int, default=3)
+    ap.add_argument("--out", default=str(ROOT / "docs" / "benchmarks-jpda"))
+    args = ap.parse_args(argv)
+    import stonesoup
+
+    from assocopt.tracking.stonesoup import jpda
+
+    load_start = [round(v, 2) for v in os.getloadavg()]
+    run_config(2, 1, 1, args.seed, 1)                   # warm-up: kernels compiled
+    rows = []
+    for cfg in args.configs.split(","):
+        size, clusters = (int(v) for v in cfg.split("x"))
+        rows.append(run_config(size, clusters, args.scans, args.seed, args.repeat))
+    result = {"command": command("python benchmarks/stonesoup_jpda.py", argv),
+              "engine": jpda.EXACT_METHOD, "spacing": SPACING, "clutter_rate": CLUTTER,
+              "rows": rows, "scans": args.scans,
+              "repeat": args.repeat,
+              "machine": machine(load_start, stonesoup=stonesoup.__version__)}
+    write_pages(Path(args.out), result, render)
+    return result
+
+
+if __name__ == "__main__":
+    main()
