@@ -15,7 +15,8 @@ from typing import Any, TextIO
 
 from ..runtime.errors import AssocoptError
 from .common import (EXIT_BAD_INPUT, EXIT_INFEASIBLE, EXIT_INTERNAL, EXIT_LIMIT, EXIT_OK, _error, _human,
-                     _matches, _num, _one_line, _os_message, _solve_record, _table, exit_code)
+                     _matches, _num, _instance_path,
+                     _one_line, _os_message, _solve_record, _table, exit_code)
 
 
 #: ``assocopt solve`` without ``--solver`` solves one problem per process: an S-D
@@ -25,17 +26,6 @@ from .common import (EXIT_BAD_INPUT, EXIT_INFEASIBLE, EXIT_INTERNAL, EXIT_LIMIT,
 #: or a search that runs out of nodes, go to ``auto``'s choice as before.
 ONE_SHOT_CANDIDATES = 64
 ONE_SHOT_NODES = 20_000
-
-
-def _instance_path(text: str) -> str:
-    """``text``, or the stored instance of that name when no such file exists
-    (``assocopt solve example-sd`` works from any folder, installed or not)."""
-    if Path(text).exists():
-        return text
-    from ..workflow.generate import find_stored_instance
-
-    stored = find_stored_instance(text)
-    return str(stored) if stored is not None else text
 
 
 def _one_shot(problem: Any, relax: str | None) -> Any:
@@ -111,7 +101,8 @@ def _cmd_kbest(args: argparse.Namespace, out: TextIO, err: TextIO) -> int:
             raise AssocoptError(f"--kbest does not combine with --{flag.replace('_', '-')}")
     if args.kbest < 1:
         raise AssocoptError(f"--kbest must be a positive integer, got {args.kbest}")
-    problem = read_instance(args.file, format=args.format, instance=args.instance)
+    problem = read_instance(_instance_path(args.file), format=args.format,
+                            instance=args.instance)
     solver = args.solver or "auto"
     begun = _compile_note(problem, solver, None, err) or _kbest_note(problem, solver, err)
     ranked = None
@@ -308,7 +299,8 @@ def _cmd_compare(args: argparse.Namespace, out: TextIO, err: TextIO) -> int:
     from ..workflow.compare import compare
 
     _check_options(args.time_limit)
-    res = compare(args.files, solvers=args.solvers, models=args.models,
+    res = compare([_instance_path(f) for f in args.files], solvers=args.solvers,
+                  models=args.models,
                   time_limit=args.time_limit, relax=args.relax, repeat=args.repeat,
                   format=args.format, instance=args.instance, progress=args.progress)
     fmt = "json" if args.json else "csv" if args.csv else "text"
@@ -338,7 +330,7 @@ def _validate_one(path: str, args: argparse.Namespace) -> dict[str, Any]:
 
     rec: dict[str, Any] = {"file": path, "ok": False}
     try:
-        p = read_instance(path, format=args.format, instance=args.instance)
+        p = read_instance(_instance_path(path), format=args.format, instance=args.instance)
     except (AssocoptError, OSError) as exc:
         rec["error"] = _os_message(exc) if isinstance(exc, OSError) else str(exc)
         return rec

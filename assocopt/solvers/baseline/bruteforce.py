@@ -24,7 +24,7 @@ from ..base import Backend, Option, RawResult, SolveOptions, register
 
 __all__ = ["BruteForceBackend", "enumerate_solutions", "count_solutions"]
 
-#: Default cap on search nodes; beyond it the search stops with TIME_LIMIT.
+#: Default cap on search nodes; beyond it the search stops with NODE_LIMIT.
 DEFAULT_MAX_NODES = 2_000_000
 
 
@@ -122,13 +122,14 @@ class BruteForceBackend(Backend):
     """Exact by enumeration; for tiny instances and as the test oracle.
 
     Extra option ``max_nodes`` (default 2,000,000): past it the search stops with
-    ``TIME_LIMIT`` and the best solution seen so far, if any.
+    ``NODE_LIMIT`` and the best solution seen so far, if any (a ``time_limit`` that
+    runs out first gives ``TIME_LIMIT``).
     """
 
     name = "bruteforce"
     description = "exhaustive enumeration of exact covers (tiny instances, test oracle)"
     options = (Option("max_nodes", "int", DEFAULT_MAX_NODES,
-                      "search nodes; past them the search stops with time_limit", low=1),)
+                      "search nodes; past them the search stops with node_limit", low=1),)
     supports_time_limit = True
 
     own_method = True
@@ -148,7 +149,9 @@ class BruteForceBackend(Backend):
                 if cost < best_cost:
                     best, best_cost = sel, cost
         except (ProblemTooLargeError, TimeoutError) as exc:
-            return RawResult(Status.TIME_LIMIT, selected=best, message=str(exc),
+            status = Status.NODE_LIMIT if isinstance(exc, ProblemTooLargeError) \
+                else Status.TIME_LIMIT
+            return RawResult(status, selected=best, message=str(exc),
                              info={"solutions_seen": count},
                              solve_time=time.perf_counter() - t0)
         dt = time.perf_counter() - t0

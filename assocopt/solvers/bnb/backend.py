@@ -254,7 +254,7 @@ class BranchBoundBackend(Backend):
                              info=info, build_time=t_build, solve_time=dt - t_build)
         if p["fallback"]:
             return self._fallback(problem, options, info, t0, k0)
-        return RawResult(Status.TIME_LIMIT, selected=selected,
+        return RawResult(Status.NODE_LIMIT, selected=selected,
                          bound=float(bound) if np.isfinite(bound) else None,
                          message=f"bnb: node budget {p['max_nodes']} spent",
                          info=info, build_time=t_build, solve_time=dt - t_build)
