@@ -70,3 +70,22 @@ def test_not_a_problem_is_named():
     with pytest.raises(InvalidProblemError, match=r"problems\[1\] must be an "
                                                    "AssignmentProblem, got list"):
         solve_many([AssignmentProblem.dense([[1.0]]), [[1.0]]])
+
+
+def test_one_shot_page_and_readme_agree_with_the_committed_run():
+    """docs/benchmarks-one-shot.md is what benchmarks/one_shot.py renders from its
+    committed JSON; the README quotes its summary; the run's own checks held."""
+    import json
+    from pathlib import Path
+
+    from conftest import load_script, page_block
+
+    root = Path(__file__).resolve().parents[1]
+    bench = load_script("benchmarks/one_shot.py", "bench_one_shot")
+    js = json.loads((root / "docs" / "benchmarks-one-shot.json").read_text())
+    page = (root / "docs" / "benchmarks-one-shot.md").read_text()
+    assert page_block(page, "one-shot") == bench.render(js).strip()
+    readme = " ".join((root / "README.md").read_text().split())
+    assert bench.summary_sentence(js) in readme
+    assert all(r["same_answers"] for r in js["batch"])
+    assert {r["instance"] for r in js["one_shot"]} == set(bench.INSTANCES)

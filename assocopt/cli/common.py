@@ -128,7 +128,7 @@ def _human(problem: Any, sol: Solution, out: TextIO) -> None:
     rows.append(("solver", f"{sol.solver}{ver}"))
     t = sol.times
     detail = ", ".join(f"{k.replace('_', ' ')} {t[k]:.3g} s"
-                       for k in ("build", "solve", "compile", "cache_load")
+                       for k in ("import", "build", "solve", "compile", "cache_load")
                        if t.get(k) is not None)
     total = t.get("total")
     rows.append(("time", (f"{total:.3g} s" if total is not None else "-")

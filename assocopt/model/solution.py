@@ -79,7 +79,10 @@ class Solution:
         ``info["requested"]`` and ``info["fallback"]`` saying so.  ``solver_version``:
         assocopt's version for assocopt's own methods, else the solver package's.
     times : dict
-        ``build`` (model construction), ``solve`` (back end) and ``total`` seconds.
+        ``build`` (model construction), ``solve`` (back end) and ``total`` seconds;
+        ``import`` (the first solve that needs a package: its import, e.g. scipy for
+        the first 2-D solve), ``compile`` and ``cache_load`` (numba kernels) when they
+        happened, which ``total`` includes and ``build`` / ``solve`` do not.
     relaxation : str or None
         ``"lp"`` when the LP relaxation was solved.
     x : ndarray or None

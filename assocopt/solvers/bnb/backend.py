@@ -178,6 +178,7 @@ class BranchBoundBackend(Backend):
 
     name = "bnb"
     module = "numba"
+    imports = ("numba",)
     distribution = "numba"
     description = ("compiled Lagrangian-bounded exact-cover branch and bound "
                    "(numba; small S-D problems)")

@@ -137,7 +137,7 @@ def run_model(model: LinearModel, icosts: np.ndarray, options: SolveOptions, *,
               time_limit: float | None = None) -> dict[str, Any]:
     """Fill a CP-SAT model with ``model``'s rows and the integer costs ``icosts`` and
     solve it in this process; what the result needs, as plain values (the same in a
-    child process, :mod:`.limited`).  ``time_limit`` replaces the options' limit (what
+    worker process, :mod:`.limited`).  ``time_limit`` replaces the options' limit (what
     is left of it)."""
     from ortools.sat.python import cp_model
 
@@ -191,6 +191,7 @@ class CpSatBackend(Backend):
 
     name = "ortools-cpsat"
     module = "ortools"
+    imports = ("ortools.sat.python.cp_model", "scipy.sparse")
     distribution = "ortools"
     description = "OR-Tools CP-SAT on the exact-cover ILP, costs scaled to integers"
     lp = False
