@@ -1,7 +1,8 @@
 """``solve_many``: many independent problems in one call, the small S-D ones batched.
 
 A loop of :func:`assocopt.solve` pays its dispatch, option parsing, a compiled call and
-the answer's checks once per problem (140-170 us each for small S-D problems).  Here
+the answer's checks once per problem, more than the small S-D solve itself costs
+(``benchmarks/one_shot.py`` measures both, docs/benchmarks-one-shot.md).  Here
 the problems ``bnb`` would get (``solver="auto"`` choosing ``bnb``, or ``solver="bnb"``;
 no options, no relaxation, no limit, no gap; small enough for ``bnb``'s kernels, costs
 in range) are stacked, each keeping its own indices, and handed to the batch kernel of
