@@ -14,10 +14,12 @@ from .problems.problem import AssignmentProblem
 from .model.solution import Solution, Status
 from . import solvers
 from .solving.api import choose_solver, solve
+from .solving.many import solve_many
 from .ranking.kbest import Ranked, kbest
 from .ranking.marginals import Marginals, marginals
 
-__all__ = ["AssignmentProblem", "Solution", "Status", "solve", "choose_solver", "solvers",
+__all__ = ["AssignmentProblem", "Solution", "Status", "solve", "solve_many", "choose_solver",
+           "solvers",
            "kbest", "Ranked", "marginals", "Marginals",
            "AssocoptError", "InvalidProblemError", "InstanceFormatError",
            "UnknownSolverError", "SolverNotInstalledError", "SolverCapabilityError",

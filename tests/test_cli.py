@@ -198,6 +198,8 @@ def test_help_and_version(capsys):
     (Solution(Status.TIME_LIMIT, objective=1.0, selected=np.array([0])), EXIT_OK),
     (Solution(Status.TIME_LIMIT, relaxation="lp", x=np.array([0.5, 0.5])), EXIT_OK),
     (Solution(Status.TIME_LIMIT), EXIT_LIMIT),
+    (Solution(Status.NODE_LIMIT, objective=1.0, selected=np.array([0])), EXIT_OK),
+    (Solution(Status.NODE_LIMIT), EXIT_LIMIT),
     (Solution(Status.INFEASIBLE, message="infeasible"), EXIT_INFEASIBLE),
     (Solution(Status.ERROR, message="boom"), EXIT_INTERNAL),
 ])
@@ -310,3 +312,32 @@ def test_cli_on_shared_grundel(capsys):
     d = json.loads(capsys.readouterr().out)
     assert d["instance"] == "ap3.10.1"
     assert d["optimum"] == d["objective"] and d["matches_recorded_optimum"] is True
+
+
+# ------------------------------------------------------------------ stored instance names
+@pytest.mark.parametrize("argv", [
+    ["solve", "example-3d", "--kbest", "2", "--solver", "bruteforce"],
+    ["validate", "example-3d"],
+    ["compare", "example-3d", "--solvers", "highs"],
+    ["export", "example-3d", "--to", "{tmp}/m.lp"],
+    ["convert", "example-3d", "{tmp}/copy.json"],
+])
+def test_stored_instance_names_in_every_command(argv, tmp_path, capsys, monkeypatch):
+    """A stored instance's name works wherever a FILE is taken, from any folder."""
+    monkeypatch.chdir(tmp_path)
+    code = main([a.replace("{tmp}", str(tmp_path)) for a in argv])
+    out, err = capsys.readouterr()
+    assert code == EXIT_OK, err
+    assert "No such file" not in err and "example-3d" in out + "".join(
+        f.read_text() for f in tmp_path.iterdir() if f.suffix == ".json")
+
+
+def test_bruteforce_node_cap_is_its_own_status():
+    """No time limit was given: a node cap is ``node_limit``, not ``time_limit``."""
+    from assocopt.io import read_instance
+
+    p = read_instance(EXAMPLES / "example-3d.json")
+    sol = assocopt.solve(p, "bruteforce", max_nodes=1)
+    assert sol.status is Status.NODE_LIMIT and "nodes" in sol.message
+    assert exit_code(sol) == EXIT_LIMIT
+    assert assocopt.solve(p, "bruteforce", time_limit=1e-9).status is Status.TIME_LIMIT

@@ -85,7 +85,7 @@ def _agree(a, b, p):
 def _reference(p):
     """The whole problem by brute force (HiGHS past brute force's node cap)."""
     whole = solve(p, "bruteforce", decompose=False)
-    if whole.status is Status.TIME_LIMIT:
+    if whole.status is Status.NODE_LIMIT:
         whole = solve(p, "highs", decompose=False)
     return whole
 

@@ -393,6 +393,8 @@ def test_json_invalid(tmp_path, doc, msg):
      "duplicate key 'kind'"),
     ('{"format": "assocopt-instance", "version": 1, "kind": "dense", "costs": [[1, 2]',
      "invalid JSON: .* at line 1"),
+    ('{"format": "assocopt-instance", "version": 1, "kind": "dense',
+     "invalid JSON: Unterminated string starting at line 1 column 55$"),
 ])
 def test_json_invalid_text(tmp_path, text, msg):
     f = write(tmp_path / "bad.json", text)
@@ -402,6 +404,9 @@ def test_json_invalid_text(tmp_path, text, msg):
 
 @pytest.mark.parametrize("doc, msg", [
     (jdoc(kind="sparse", sizes=[1, 1], tuples=[[1, 2]], costs=[1]), "index out of range"),
+    (jdoc(kind="sparse", sizes=[2, 3, 4], tuples=[[1, 1, 1], [2, 0, 5]], costs=[1, 2]),
+     r"tuple 1 = \[2, 0, 5\] has an index out of range: 5 on axis 2, which takes "
+     r"0 \(dummy\) \.\. 4"),
     (jdoc(kind="sparse", sizes=[1, 1], tuples=[[1, 1], [1, 1]], costs=[1, 2]), "duplicate candidate"),
     (jdoc(kind="sparse", sizes=[1, 1], tuples=[[0, 0]], costs=[1]), "all-dummy"),
     (jdoc(kind="sparse", sizes=[-1, 1], tuples=[], costs=[]), "non-negative"),

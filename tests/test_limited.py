@@ -1,5 +1,6 @@
-"""Time limits that hold: under a limit, HiGHS, scipy's milp and cvxpy solve in a child
-process (``assocopt.solvers.milp.limited``) that is killed at the deadline or on Ctrl-C.
+"""Time limits that hold: under a limit, HiGHS, scipy's milp, cvxpy and OR-tools solve in
+a warm worker process (``assocopt.solvers.milp.limited``), reused across calls, that is
+killed at the deadline or on Ctrl-C and started afresh by the next call.
 
 No wall-clock assertions: a killed child is recognised by ``info["isolated"]`` and the
 autouse fixture of conftest.py checks that no child process outlives its test.
@@ -90,6 +91,7 @@ def test_ctrl_c_kills_the_child(solver, hard, sigint_python, monkeypatch):
 
     monkeypatch.setattr(limited, "subprocess", SimpleNamespace(
         Popen=popen, PIPE=subprocess.PIPE, TimeoutExpired=subprocess.TimeoutExpired))
+    limited.shutdown()                    # no warm worker: this call starts one
     try:
         with pytest.raises(KeyboardInterrupt):
             solve(hard, solver, time_limit=600.0)
@@ -97,6 +99,81 @@ def test_ctrl_c_kills_the_child(solver, hard, sigint_python, monkeypatch):
         for timer in timers:
             timer.cancel()
     assert len(children) == 1 and children[0].returncode == -signal.SIGKILL
+
+
+@pytest.mark.parametrize("solver", ISOLATED)
+def test_the_worker_is_reused_and_restarted_after_a_kill(solver, hard, monkeypatch):
+    """Calls under a limit share one warm worker (no process start per call); one
+    killed at the deadline is replaced by a new one on the next call."""
+    p = AssignmentProblem.dense(np.round(100 * np.random.default_rng(2).random((4, 4, 4))))
+    limited.shutdown()
+    started: list[subprocess.Popen] = []
+    real = subprocess.Popen
+
+    def popen(*args, **kwargs):
+        started.append(real(*args, **kwargs))
+        return started[-1]
+
+    monkeypatch.setattr(limited, "subprocess", SimpleNamespace(
+        Popen=popen, PIPE=subprocess.PIPE, TimeoutExpired=subprocess.TimeoutExpired))
+    first = solve(p, solver, time_limit=60.0)
+    again = [solve(p, solver, time_limit=1e300) for _ in range(3)]
+    assert len(started) == 1
+    assert first.info["isolated"] >= 0 and all(s.info["isolated"] >= 0 for s in again)
+    assert {s.objective for s in again} == {first.objective}
+    monkeypatch.setattr(limited, "kill_slack", lambda limit: 0.5 - limit)
+    assert solve(hard, solver, time_limit=60.0).info["isolated"] == "killed"
+    assert started[0].returncode == -signal.SIGKILL
+    monkeypatch.undo()
+    monkeypatch.setattr(limited, "subprocess", SimpleNamespace(
+        Popen=popen, PIPE=subprocess.PIPE, TimeoutExpired=subprocess.TimeoutExpired))
+    assert solve(p, solver, time_limit=60.0).objective == first.objective
+    assert len(started) == 2 and started[1].poll() is None
+
+
+def test_a_dead_idle_worker_is_replaced():
+    """A warm worker that died while idle (killed from outside) is noticed and a new
+    one answers: the call does not fail."""
+    if "highs" not in ISOLATED:
+        pytest.skip("highspy not installed")
+    p = AssignmentProblem.dense(np.random.default_rng(1).random((3, 3)))
+    limited.shutdown()
+    ref = solve(p, "highs", time_limit=60.0).objective
+    (worker,) = limited._IDLE["assocopt.solvers.milp.highs"]
+    worker.proc.kill()
+    worker.proc.wait()
+    assert solve(p, "highs", time_limit=60.0).objective == ref
+
+
+def test_a_forked_child_does_not_share_the_warm_workers():
+    """A fork (a process pool) must not write to, or end, its parent's workers."""
+    import os
+
+    if "highs" not in ISOLATED:
+        pytest.skip("highspy not installed")
+    p = AssignmentProblem.dense(np.random.default_rng(1).random((3, 3)))
+    ref = solve(p, "highs", time_limit=60.0).objective
+    (worker,) = limited._IDLE["assocopt.solvers.milp.highs"]
+    pid = os.fork()
+    if pid == 0:                                   # the child: nothing inherited
+        os._exit(0 if not limited._IDLE else 1)
+    _, status = os.waitpid(pid, 0)
+    assert os.waitstatus_to_exitcode(status) == 0
+    assert worker.alive() and limited._IDLE["assocopt.solvers.milp.highs"] == [worker]
+    assert solve(p, "highs", time_limit=60.0).objective == ref
+
+
+@pytest.mark.parametrize("solver", [n for n, cls in sorted(registered().items())
+                                    if cls.supports_time_limit and cls.is_available()])
+def test_any_time_limit_up_to_inf_is_accepted(solver):
+    costs = np.round(100 * np.random.default_rng(3).random((3, 3, 3)))
+    p = AssignmentProblem.dense(costs if registered()[solver].max_ndim is None
+                                else costs[0])
+    ref = solve(p, "bruteforce")
+    for limit in (1e300, float("inf"), 1e9):
+        sol = solve(p, solver, time_limit=limit)
+        assert sol.status in (Status.OPTIMAL, Status.FEASIBLE), (limit, sol.message)
+        assert sol.objective == pytest.approx(ref.objective)
 
 
 def test_an_error_in_the_child_is_raised_here():

@@ -51,7 +51,8 @@ def test_cli_parser_and_solvers_listing_stay_light(tmp_path):
 
 def test_2d_solve_loads_only_its_back_end():
     mods = _loaded("from assocopt.cli import main\n"
-                   "assert main(['solve', 'instances/example-2d-miss.json']) == 0")
+                   "assert main(['solve', 'instances/example-2d-miss.json', '--solver', "
+                   "'scipy-lsa']) == 0")
     assert "scipy.optimize" in mods          # linear_sum_assignment
     assert set(_heavy(mods)) <= {"scipy.optimize", "scipy.sparse"}  # scipy's own imports
     from assocopt.solvers import BACKEND_MODULES
@@ -66,7 +67,8 @@ def test_2d_solve_loads_only_its_back_end():
 @pytest.mark.skipif(importlib.util.find_spec("numba") is None, reason="needs numba")
 def test_bnb_solve_loads_numba_but_not_the_other_back_ends():
     mods = _loaded("from assocopt.cli import main\n"
-                   "assert main(['solve', 'instances/sd-bearing-3s.json']) == 0")
+                   "assert main(['solve', 'instances/sd-bearing-3s.json', '--solver', "
+                   "'bnb']) == 0")
     assert "numba" in mods and "assocopt.solvers.bnb.kernels" in mods
     for other in ("highspy", "ortools", "cvxpy", "assocopt.solvers.milp.highs",
                   "assocopt.solvers.lagrangian"):
@@ -79,6 +81,56 @@ def test_tiny_sd_solve_from_the_cli_loads_no_compiled_kernels(capsys):
                    "assert main(['solve', 'instances/example-sd.json']) == 0")
     assert _heavy(mods) == []
     assert "assocopt.solvers.baseline.bruteforce" in mods
+
+
+def test_small_sd_solve_from_the_cli_goes_to_highs_without_numba():
+    """One S-D problem above the enumeration's size in a fresh process: HiGHS (its
+    import and solve are cheaper than numba's import and bnb's kernels' load)."""
+    if importlib.util.find_spec("highspy") is None:
+        pytest.skip("needs highspy")
+    mods = _loaded("from assocopt.cli import main\n"
+                   "assert main(['solve', 'instances/sd-bearing-3s.json']) == 0")
+    assert "highspy" in mods and "numba" not in mods
+    assert "assocopt.solvers.bnb.kernels" not in mods
+
+
+def test_one_shot_highs_answer_equals_auto_in_the_library(capsys):
+    from assocopt import solve
+    from assocopt.cli import main
+    from assocopt.io import read_instance
+    import assocopt.cli.solve_cmds as sc
+
+    if importlib.util.find_spec("highspy") is None:
+        pytest.skip("needs highspy")
+    for name in ("sd-bearing-3s", "planted-3d-8", "grundel-ap3.10.1", "axial-4d-4x4x4x4",
+                 "example-2d-miss", "rect-2d-5x8"):
+        path = ROOT / "instances" / f"{name}.json"
+        p = read_instance(path)
+        assert main(["solve", str(path), "--json"]) == 0
+        rec = json.loads(capsys.readouterr().out)
+        small = p.n_candidates > sc.ONE_SHOT_CANDIDATES or p.ndim == 2
+        want = "highs" if small and p.n_candidates <= sc.ONE_SHOT_HIGHS else None
+        if want:
+            assert rec["solver"] == want and "HiGHS rather than" in rec["message"], name
+            assert rec["info"]["one_shot"] is True
+        assert rec["status"] == "optimal"
+        assert rec["objective"] == pytest.approx(solve(p).objective, abs=1e-9)
+
+
+def test_the_first_solve_labels_its_imports():
+    """An import is no solve time: the first 2-D solve (scipy) and the first HiGHS
+    solve (highspy, scipy.sparse) report it as times["import"], later ones do not."""
+    code = ("import json, numpy as np, assocopt\n"
+            "p = assocopt.AssignmentProblem.dense(np.arange(9.0).reshape(3, 3))\n"
+            "q = assocopt.AssignmentProblem.dense(np.arange(27.0).reshape(3, 3, 3))\n"
+            "t = [assocopt.solve(p).times, assocopt.solve(p).times]\n"
+            "if __import__('importlib').util.find_spec('highspy'):\n"
+            "    t += [assocopt.solve(q, 'highs').times, assocopt.solve(q, 'highs').times]\n"
+            "print(json.dumps(t))")
+    times = json.loads(fresh_python(code).splitlines()[-1])
+    for first, later in zip(times[::2], times[1::2]):
+        assert first["import"] > 0 and "import" not in later
+        assert first["total"] >= first["import"] + first["build"] + first["solve"]
 
 
 def test_one_shot_answer_equals_auto_in_the_library(capsys):

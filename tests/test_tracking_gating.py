@@ -170,6 +170,18 @@ def test_bad_input_is_named():
         gate([[0.0, 0.0]], np.eye(3), [[0.0, 0.0]])
     with pytest.raises(InvalidProblemError, match=r"P must have shape \(1, 2, 2\) or \(2, 2\)"):
         predict_measurements([[1.0, 0.5]], np.eye(3), [[1.0, 0.0]])
+    with pytest.raises(InvalidProblemError, match="P is not positive semi-definite .*negative"):
+        predict_measurements([[1.0, 0.5]], -np.eye(2), [[1.0, 0.0]])
+    with pytest.raises(InvalidProblemError, match=r"P\[1\] is not positive semi-definite "
+                                                  r"\(it is indefinite"):
+        predict_measurements([[1.0, 0.5]] * 2, [np.eye(2), np.diag([1.0, -1.0])],
+                             [[1.0, 0.0]])
+    with pytest.raises(InvalidProblemError, match="P is not symmetric"):
+        predict_measurements([[1.0, 0.5]], [[1.0, 0.5], [0.0, 1.0]], [[1.0, 0.0]])
+    with pytest.raises(InvalidProblemError, match="R is not positive semi-definite"):
+        predict_measurements([[1.0, 0.5]], np.eye(2), [[1.0, 0.0]], [[-0.1]])
+    z, S = predict_measurements([[1.0, 0.5]], np.zeros((2, 2)), [[1.0, 0.0]], [[0.1]])
+    assert S.tolist() == [[[0.1]]]          # a singular (known) state is a covariance
     with pytest.raises(InvalidProblemError, match="gate probability"):
         gate([[0.0, 0.0]], np.eye(2), [[0.0, 0.0]], probability=1.0)
     with pytest.raises(InvalidProblemError, match="clutter_density must be > 0"):

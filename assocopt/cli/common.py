@@ -8,6 +8,7 @@ defined once.
 from __future__ import annotations
 
 import math
+from pathlib import Path
 from typing import Any, Sequence, TextIO
 
 from ..model.solution import Solution, Status
@@ -35,10 +36,22 @@ def exit_code(solution: Solution) -> int:
         return EXIT_OK
     if status is Status.INFEASIBLE:
         return EXIT_INFEASIBLE
-    if status is Status.TIME_LIMIT:
+    if status.is_limit:
         has = solution.has_solution or solution.x is not None
         return EXIT_OK if has else EXIT_LIMIT
     return EXIT_INTERNAL
+
+
+def _instance_path(text: str) -> str:
+    """``text``, or the stored instance of that name when no such file exists
+    (``assocopt solve example-sd`` works from any folder, installed or not); every
+    command that reads an instance file resolves its argument through this."""
+    if Path(text).exists():
+        return text
+    from ..workflow.generate import find_stored_instance
+
+    stored = find_stored_instance(text)
+    return str(stored) if stored is not None else text
 
 
 # ------------------------------------------------------------------ errors
@@ -115,7 +128,7 @@ def _human(problem: Any, sol: Solution, out: TextIO) -> None:
     rows.append(("solver", f"{sol.solver}{ver}"))
     t = sol.times
     detail = ", ".join(f"{k.replace('_', ' ')} {t[k]:.3g} s"
-                       for k in ("build", "solve", "compile", "cache_load")
+                       for k in ("import", "build", "solve", "compile", "cache_load")
                        if t.get(k) is not None)
     total = t.get("total")
     rows.append(("time", (f"{total:.3g} s" if total is not None else "-")

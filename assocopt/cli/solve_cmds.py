@@ -15,41 +15,51 @@ from typing import Any, TextIO
 
 from ..runtime.errors import AssocoptError
 from .common import (EXIT_BAD_INPUT, EXIT_INFEASIBLE, EXIT_INTERNAL, EXIT_LIMIT, EXIT_OK, _error, _human,
-                     _matches, _num, _one_line, _os_message, _solve_record, _table, exit_code)
+                     _matches, _num, _instance_path,
+                     _one_line, _os_message, _solve_record, _table, exit_code)
 
 
-#: ``assocopt solve`` without ``--solver`` solves one problem per process: an S-D
-#: problem this small is first enumerated exhaustively (``bruteforce``, numpy only,
-#: at most :data:`ONE_SHOT_NODES` search nodes: 25-65 ms measured), which is quicker
-#: than importing numba and loading ``bnb``'s kernels (0.3-0.5 s).  Larger problems,
-#: or a search that runs out of nodes, go to ``auto``'s choice as before.
+#: ``assocopt solve`` without ``--solver`` solves one problem per process, where
+#: ``auto``'s ``bnb`` would first import numba and load its compiled kernels (0.4-0.5 s
+#: of a 0.5-1.4 s command).  So an S-D problem this small is first enumerated
+#: exhaustively (``bruteforce``, numpy only, at most :data:`ONE_SHOT_NODES` search
+#: nodes: an attempt that runs out of them costs 10-30 ms, 20,000 cost 0.2 s
+#: under load), and one of at most :data:`ONE_SHOT_HIGHS` candidates
+#: goes to HiGHS (its import and solve cost less than numba's load there: measured
+#: by ``benchmarks/one_shot.py``, docs/benchmarks-one-shot.md).  So does a 2-D problem
+#: of that size: scipy.optimize, which ``auto``'s 2-D path imports, costs more to
+#: import than HiGHS and scipy.sparse (1.4x the command's CPU seconds measured).
+#: Larger problems, or a search that runs out of nodes, go to ``auto``'s choice.
 ONE_SHOT_CANDIDATES = 64
-ONE_SHOT_NODES = 20_000
-
-
-def _instance_path(text: str) -> str:
-    """``text``, or the stored instance of that name when no such file exists
-    (``assocopt solve example-sd`` works from any folder, installed or not)."""
-    if Path(text).exists():
-        return text
-    from ..workflow.generate import find_stored_instance
-
-    stored = find_stored_instance(text)
-    return str(stored) if stored is not None else text
+ONE_SHOT_NODES = 2_000
+ONE_SHOT_HIGHS = 1_000
 
 
 def _one_shot(problem: Any, relax: str | None) -> Any:
-    """The exact answer by enumeration for a tiny S-D problem, or None (see above)."""
+    """The exact answer of a small problem by the cheapest route for one solve in a
+    fresh process (see above), or None for ``auto`` to answer."""
     from ..solving.api import solve
     from ..model.solution import Status
+    from ..solvers.base import module_installed
 
-    if relax is not None or problem.ndim < 3 or problem.n_candidates > ONE_SHOT_CANDIDATES:
+    if relax is not None:
         return None
-    sol = solve(problem, "bruteforce", max_nodes=ONE_SHOT_NODES)
+    if problem.ndim >= 3 and problem.n_candidates <= ONE_SHOT_CANDIDATES:
+        sol = solve(problem, "bruteforce", max_nodes=ONE_SHOT_NODES)
+        if sol.status in (Status.OPTIMAL, Status.INFEASIBLE):
+            sol.message = (f"{sol.message} (auto: one small problem, enumerated rather "
+                           "than loading the compiled bnb kernels)")
+            sol.info.update(requested="auto", one_shot=True)
+            return sol
+    if problem.n_candidates > ONE_SHOT_HIGHS or not module_installed("highspy"):
+        return None
+    sol = solve(problem, "highs")
     if sol.status not in (Status.OPTIMAL, Status.INFEASIBLE):
         return None
-    sol.message = (f"{sol.message} (auto: one small problem, enumerated rather than "
-                   "loading the compiled bnb kernels)")
+    rather = "importing scipy.optimize" if problem.ndim == 2 else \
+        "loading the compiled bnb kernels"
+    sol.message = (f"{sol.message} (auto: one small problem in a fresh process, solved "
+                   f"by HiGHS rather than {rather})")
     sol.info.update(requested="auto", one_shot=True)
     return sol
 
@@ -111,7 +121,8 @@ def _cmd_kbest(args: argparse.Namespace, out: TextIO, err: TextIO) -> int:
             raise AssocoptError(f"--kbest does not combine with --{flag.replace('_', '-')}")
     if args.kbest < 1:
         raise AssocoptError(f"--kbest must be a positive integer, got {args.kbest}")
-    problem = read_instance(args.file, format=args.format, instance=args.instance)
+    problem = read_instance(_instance_path(args.file), format=args.format,
+                            instance=args.instance)
     solver = args.solver or "auto"
     begun = _compile_note(problem, solver, None, err) or _kbest_note(problem, solver, err)
     ranked = None
@@ -308,7 +319,8 @@ def _cmd_compare(args: argparse.Namespace, out: TextIO, err: TextIO) -> int:
     from ..workflow.compare import compare
 
     _check_options(args.time_limit)
-    res = compare(args.files, solvers=args.solvers, models=args.models,
+    res = compare([_instance_path(f) for f in args.files], solvers=args.solvers,
+                  models=args.models,
                   time_limit=args.time_limit, relax=args.relax, repeat=args.repeat,
                   format=args.format, instance=args.instance, progress=args.progress)
     fmt = "json" if args.json else "csv" if args.csv else "text"
@@ -338,7 +350,7 @@ def _validate_one(path: str, args: argparse.Namespace) -> dict[str, Any]:
 
     rec: dict[str, Any] = {"file": path, "ok": False}
     try:
-        p = read_instance(path, format=args.format, instance=args.instance)
+        p = read_instance(_instance_path(path), format=args.format, instance=args.instance)
     except (AssocoptError, OSError) as exc:
         rec["error"] = _os_message(exc) if isinstance(exc, OSError) else str(exc)
         return rec

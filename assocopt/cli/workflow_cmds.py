@@ -16,7 +16,7 @@ from pathlib import Path
 from typing import Any, Sequence, TextIO
 
 from ..runtime.errors import AssocoptError
-from .common import EXIT_OK, _num, _one_line, _table, _UsageError
+from .common import EXIT_OK, _instance_path, _num, _one_line, _table, _UsageError
 
 
 def _cmd_models(args: argparse.Namespace, out: TextIO, err: TextIO) -> int:
@@ -39,7 +39,8 @@ def _cmd_export(args: argparse.Namespace, out: TextIO, err: TextIO) -> int:
     from ..io.mps_lp import export_model
     from ..io import read_instance
 
-    problem = read_instance(args.file, format=args.format, instance=args.instance)
+    problem = read_instance(_instance_path(args.file), format=args.format,
+                            instance=args.instance)
     info = export_model(problem, args.to, relax=args.relax, names=not args.no_names)
     what = "LP relaxation" if args.relax else "ILP"
     print(f"wrote {info['path']}: {what} of {problem.name}, {info['columns']} "
@@ -81,7 +82,8 @@ def _cmd_convert(args: argparse.Namespace, out: TextIO, err: TextIO) -> int:
 
     prove = functools.partial(prove_optimum, time_limit=args.time_limit) if args.prove \
         else None
-    info = convert(args.src, args.dst, from_format=args.format, to_format=args.to_format,
+    info = convert(_instance_path(args.src), args.dst, from_format=args.format,
+                   to_format=args.to_format,
                    instance=args.instance, prove=prove)
     opt = "" if info["optimum"] is None else f"; optimum {_num(info['optimum'])}"
     print(f"wrote {', '.join(info['written'])} ({info['format']} format): {info['name']}, "

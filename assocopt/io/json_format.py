@@ -187,7 +187,10 @@ def _read_json(path: Path, text: str) -> AssignmentProblem:
         doc = json.loads(text, object_pairs_hook=_no_duplicates,
                          parse_constant=_parse_constant, **hooks)
     except json.JSONDecodeError as exc:
-        raise _fail(path, f"invalid JSON: {exc.msg} at line {exc.lineno} column {exc.colno}") from None
+        # json's own messages may end in "at" ("Unterminated string starting at")
+        msg = exc.msg[:-3] if exc.msg.endswith(" at") else exc.msg
+        raise _fail(path, f"invalid JSON: {msg} at line {exc.lineno} column "
+                          f"{exc.colno}") from None
     except RecursionError:
         raise _fail(path, "invalid JSON: nested too deeply") from None
     except ValueError as exc:

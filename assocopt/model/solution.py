@@ -19,8 +19,11 @@ class Status(str, enum.Enum):
     ``FEASIBLE``: a feasible solution without a proof of optimality (heuristics,
     or a gap tolerance above zero).
     ``INFEASIBLE``: proven that no feasible solution exists.
-    ``TIME_LIMIT``: stopped by a time, node or iteration limit; a solution may or
+    ``TIME_LIMIT``: stopped by a time or iteration limit; a solution may or
     may not be attached (see :attr:`Solution.has_solution`).  Never "optimal".
+    ``NODE_LIMIT``: stopped by a cap on search nodes that the method sets itself
+    (``bruteforce``'s ``max_nodes``), with or without a time limit given; a solution
+    may or may not be attached.  Never "optimal".
     ``ERROR``: the back end failed; see :attr:`Solution.message`.
     """
 
@@ -28,10 +31,16 @@ class Status(str, enum.Enum):
     FEASIBLE = "feasible"
     INFEASIBLE = "infeasible"
     TIME_LIMIT = "time_limit"
+    NODE_LIMIT = "node_limit"
     ERROR = "error"
 
     def __str__(self) -> str:
         return self.value
+
+    @property
+    def is_limit(self) -> bool:
+        """True for a run stopped by a limit (time, iterations or nodes)."""
+        return self in (Status.TIME_LIMIT, Status.NODE_LIMIT)
 
 
 def relative_gap(objective: float | None, bound: float | None) -> float | None:
@@ -70,7 +79,10 @@ class Solution:
         ``info["requested"]`` and ``info["fallback"]`` saying so.  ``solver_version``:
         assocopt's version for assocopt's own methods, else the solver package's.
     times : dict
-        ``build`` (model construction), ``solve`` (back end) and ``total`` seconds.
+        ``build`` (model construction), ``solve`` (back end) and ``total`` seconds;
+        ``import`` (the first solve that needs a package: its import, e.g. scipy for
+        the first 2-D solve), ``compile`` and ``cache_load`` (numba kernels) when they
+        happened, which ``total`` includes and ``build`` / ``solve`` do not.
     relaxation : str or None
         ``"lp"`` when the LP relaxation was solved.
     x : ndarray or None

@@ -204,9 +204,11 @@ def check_tuples(tuples: ArrayLike, sizes: tuple[int, ...]) -> np.ndarray:
     bad_rows = np.flatnonzero(((raw < 0) | (raw > upper)).any(axis=1))
     if len(bad_rows):
         k = int(bad_rows[0])
+        row = [int(v) for v in raw[k]]
+        s = next(a for a, v in enumerate(row) if v < 0 or v > int(sizes[a]))
         raise InvalidProblemError(
-            f"tuple {k} = {[int(v) for v in raw[k]]} has an index out of range: axis s "
-            f"takes 0 (dummy) .. n_s with sizes {list(sizes)}")
+            f"tuple {k} = {row} has an index out of range: {row[s]} on axis {s}, which "
+            f"takes 0 (dummy) .. {int(sizes[s])} (sizes {list(sizes)})")
     T = raw.astype(np.int64)
     all_dummy = np.flatnonzero((T == 0).all(axis=1))
     if len(all_dummy):

@@ -135,6 +135,20 @@ def _distribution_version(dist: str) -> str:
         return ""
 
 
+def import_missing(modules: tuple[str, ...]) -> float:
+    """Import those of ``modules`` not yet loaded; the seconds it took (0.0 when all
+    were loaded: a dictionary lookup each)."""
+    import sys
+    missing = [m for m in modules if m not in sys.modules]
+    if not missing:
+        return 0.0
+    import time
+    t = time.perf_counter()
+    for m in missing:
+        importlib.import_module(m)
+    return time.perf_counter() - t
+
+
 @functools.lru_cache(maxsize=None)
 def module_installed(module: str) -> bool:
     """Whether ``module`` can be imported, looked up once per process (``find_spec``
@@ -179,6 +193,10 @@ class Backend:
     #: The method is assocopt's own (its version is assocopt's, even when a package
     #: such as numba runs it).
     own_method: ClassVar[bool] = False
+    #: Modules its solve imports on first use (the solver package and what building
+    #: its model needs): :func:`assocopt.solve` imports the missing ones first and
+    #: reports the seconds as ``times["import"]``, not as build or solve time.
+    imports: ClassVar[tuple[str, ...]] = ()
 
     @classmethod
     def is_native_option(cls, name: str) -> bool:

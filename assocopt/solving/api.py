@@ -11,7 +11,7 @@ from ..runtime.errors import InvalidProblemError
 from ..problems.problem import AssignmentProblem, index_label
 from ..model.solution import Solution, Status
 from ..solvers.base import (Backend, RawResult, SolveOptions, check_capabilities,
-                            empty_answer, get_backend, module_installed)
+                            empty_answer, get_backend, import_missing, module_installed)
 from ..solvers.kernels import spent
 from ..solvers.scaling import solve_in_range
 from .choice import BNB_MAX_CANDIDATES, choose_solver
@@ -69,8 +69,12 @@ def solve(problem: AssignmentProblem, solver: str = "auto", *, relax: str | None
     if (solver == "auto" or solver == "scipy-lsa") and problem._dense is not None and \
             not options and relax is None and time_limit is None and threads is None \
             and verbose is False and type(mip_gap) is float and mip_gap == 0.0:
-        sol = _direct_path()(problem, problem._dense, t0)   # no dispatch, one pass
+        direct = _DIRECT or _direct_path()
+        sol = direct(problem, problem._dense, t0)   # no dispatch, one pass
         if sol is not None:
+            if direct is not _DIRECT_SEEN[0]:        # the first: scipy was imported
+                _DIRECT_SEEN[0] = direct
+                sol.times["import"] = _DIRECT_IMPORT[0]
             return sol
     if relax is not None and relax != "lp":
         raise InvalidProblemError(f"relax must be None or 'lp', got {relax!r}")
@@ -80,6 +84,7 @@ def solve(problem: AssignmentProblem, solver: str = "auto", *, relax: str | None
     if backend_cls.module is not None and not module_installed(backend_cls.module):
         backend_cls.require()        # cached lookup first: a scan's solve is microseconds
     parsed = backend_cls.parse_options(options)
+    imported = import_missing(backend_cls.imports) if backend_cls.imports else 0.0
     if time_limit is None and threads is None and verbose is False and \
             type(mip_gap) is float and mip_gap == 0.0:
         opts = SolveOptions.parsed_defaults(relax, parsed)    # nothing to check
@@ -105,6 +110,8 @@ def solve(problem: AssignmentProblem, solver: str = "auto", *, relax: str | None
             _kernel_times(raw, k0, k1)
     sol = _finalise(problem, backend_cls, raw, relax)
     sol.info.setdefault("options", parsed)
+    if imported:
+        sol.times["import"] = imported
     sol.times["total"] = time.perf_counter() - t0
     return sol
 
@@ -119,6 +126,10 @@ def _decomposable(problem: AssignmentProblem, opts: SolveOptions) -> bool:
 
 
 _DIRECT = None
+#: The seconds the direct path's import took, and the function once a solve has
+#: reported them (as ``times["import"]``: scipy's import is no solve time).
+_DIRECT_IMPORT = [0.0]
+_DIRECT_SEEN: list[Any] = [None]
 
 
 def _direct_path():
@@ -126,7 +137,9 @@ def _direct_path():
     scipy, which ``import assocopt`` does not)."""
     global _DIRECT
     if _DIRECT is None:
+        t = time.perf_counter()
         from ..solvers.twod.direct import solve_direct
+        _DIRECT_IMPORT[0] = time.perf_counter() - t
         _DIRECT = solve_direct
     return _DIRECT
 

@@ -179,7 +179,8 @@ class _Outcome:
         self.add(raw.status, sel, raw.bound, raw.solver or solver, count, raw.message)
 
     def status(self) -> Status:
-        for s in (Status.ERROR, Status.INFEASIBLE, Status.TIME_LIMIT, Status.FEASIBLE):
+        for s in (Status.ERROR, Status.INFEASIBLE, Status.TIME_LIMIT, Status.NODE_LIMIT,
+                  Status.FEASIBLE):
             if s in self.statuses:
                 return s
         return Status.OPTIMAL
@@ -230,7 +231,7 @@ def solve_decomposed(problem: AssignmentProblem, requested: str, name: str,
     if out.messages:
         msg += "; " + "; ".join(out.messages[:3])
     return RawResult(status, selected=sel, bound=out.bound if sel is not None or
-                     status is Status.TIME_LIMIT else None, message=msg, info=info,
+                     status.is_limit else None, message=msg, info=info,
                      solve_time=time.perf_counter() - t0, solver=main)
 
 

@@ -178,6 +178,7 @@ class BranchBoundBackend(Backend):
 
     name = "bnb"
     module = "numba"
+    imports = ("numba",)
     distribution = "numba"
     description = ("compiled Lagrangian-bounded exact-cover branch and bound "
                    "(numba; small S-D problems)")
@@ -254,7 +255,7 @@ class BranchBoundBackend(Backend):
                              info=info, build_time=t_build, solve_time=dt - t_build)
         if p["fallback"]:
             return self._fallback(problem, options, info, t0, k0)
-        return RawResult(Status.TIME_LIMIT, selected=selected,
+        return RawResult(Status.NODE_LIMIT, selected=selected,
                          bound=float(bound) if np.isfinite(bound) else None,
                          message=f"bnb: node budget {p['max_nodes']} spent",
                          info=info, build_time=t_build, solve_time=dt - t_build)

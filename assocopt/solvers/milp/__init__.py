@@ -5,7 +5,7 @@
 * :mod:`.ortools_cpsat` -- OR-Tools CP-SAT (``ortools-cpsat``, integer costs);
 * :mod:`.ortools_mip` -- OR-Tools model builder over SCIP, GLOP for the LP (``ortools-mip``);
 * :mod:`.cvxpy_backend` -- cvxpy over an installed MILP solver (``cvxpy``);
-* :mod:`.limited` -- time limits that hold: a solve in a child process that can be ended.
+* :mod:`.limited` -- time limits that hold: a solve in a warm worker process that can be ended.
 
 Each back end imports its solver package only inside ``solve``.  Nothing is imported
 here.

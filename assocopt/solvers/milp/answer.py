@@ -45,8 +45,8 @@ def built_model(problem: AssignmentProblem,
 
 
 def note_isolated(info: dict[str, Any], out: dict[str, Any]) -> dict[str, Any]:
-    """``info`` with the child process's start-up seconds (``info["isolated"]``) when
-    the solve ran in one."""
+    """``info`` with the seconds until the worker process had read the model (a new
+    worker's start included; ``info["isolated"]``) when the solve ran in one."""
     if "startup" in out:
         info["isolated"] = round(out["startup"], 4)
     return info

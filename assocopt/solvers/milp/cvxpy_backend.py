@@ -167,6 +167,7 @@ class CvxpyBackend(Backend):
 
     name = "cvxpy"
     module = "cvxpy"
+    imports = ("cvxpy", "scipy.sparse")
     distribution = "cvxpy"
     description = "CVXPY model (boolean x, A @ x == 1) on HiGHS or another installed solver"
     lp = True
@@ -259,7 +260,7 @@ def run_model(model: LinearModel, requested: str | None, user_opts: dict[str, An
               options: SolveOptions, *, time_limit: float | None = None) -> dict[str, Any]:
     """CVXPY's model of ``model`` compiled and solved in this process (the solver call in
     a worker thread, so that Ctrl-C takes effect at once, see :mod:`.interruptible`);
-    what the result needs as plain values (the same in a child process, :mod:`.limited`).
+    what the result needs as plain values (the same in a worker process, :mod:`.limited`).
     ``time_limit`` counts from the call; the solver gets what compilation left of it."""
     import cvxpy as cp
 

@@ -107,7 +107,7 @@ def run_highs(h: Any, deadline: float | None = None) -> None:
 def run_model(model: LinearModel, options: SolveOptions, *,
               time_limit: float | None = None) -> dict[str, Any]:
     """Solve ``model`` with HiGHS in this process; what the result needs, as plain
-    values (the same in a child process, :mod:`.limited`).  ``time_limit`` replaces
+    values (the same in a worker process, :mod:`.limited`).  ``time_limit`` replaces
     the options' limit (what is left of it in the child)."""
     import dataclasses
 
@@ -135,6 +135,7 @@ class HighsBackend(Backend):
 
     name = "highs"
     module = "highspy"
+    imports = ("highspy", "scipy.sparse")
     distribution = "highspy"
     description = "HiGHS MIP/LP solver through highspy, model passed as one CSR matrix"
     lp = True

@@ -3,8 +3,10 @@
 CP-SAT only takes integer objective coefficients, so float costs are multiplied by
 a power of ten and rounded to int64.  When that rounding is exact (integer costs,
 or decimals such as 0.25 with scale 100) CP-SAT's optimum is the true optimum; when
-it is not, CP-SAT's optimum is only near-optimal and is reported as ``FEASIBLE``
-with a lower bound that accounts for the rounding (see :func:`_scaled_costs`).
+it is not, the lower bound accounts for the rounding (see :func:`_scaled_costs`), and
+CP-SAT's optimum is reported ``OPTIMAL`` when that corrected bound is within the
+relative gap every other back end counts as zero (:data:`~assocopt.solvers.status.GAP_ZERO`)
+of the solution's true cost, else ``FEASIBLE``.
 
 The CpModelProto is filled in bulk: all K Boolean variables in one
 ``variables.extend`` of a shared template, the objective with two numpy
@@ -13,7 +15,7 @@ The CpModelProto is filled in bulk: all K Boolean variables in one
 Extra options (``assocopt.solve(..., solver="ortools-cpsat", **extra)``):
 
 ``scale``  positive number, or ``"auto"`` (default): 1 for integer costs, else
-           the largest ``10**k`` (k <= 9) keeping ``max|c| * scale * rows`` below
+           the largest ``10**k`` (k <= 12) keeping ``max|c| * scale * rows`` below
            1e15 (exact in float64) and ``sum|c| * scale`` below 2**62 (CP-SAT's
            int64 overflow check).
 ``num_workers``  CP-SAT workers (default :data:`DEFAULT_WORKERS` = 8 unless ``threads``
@@ -42,7 +44,7 @@ from ..base import Backend, Option, RawResult, SolveOptions, register, remaining
 from ..interruptible import run_cancellable
 from .answer import built_model, note_isolated
 from .limited import ISOLATE, solve_isolated_or_here
-from ..status import from_table, settle_optimal
+from ..status import GAP_ZERO, from_table, settle_optimal
 
 __all__ = ["CpSatBackend", "run_model"]
 
@@ -55,7 +57,7 @@ _MAX_SCALED_SUM = 2.0 ** 62
 #: assign100 in 300 s; 8 workers (interleaved on the cores) prove it in about 3.5 s.
 DEFAULT_WORKERS = 8
 #: Largest decimal exponent "auto" scaling uses.
-_MAX_EXPONENT = 9
+_MAX_EXPONENT = 12
 
 # Native CP-SAT status -> assocopt status, before the rounding and gap refinements
 # made in ``CpSatBackend._status``.  CP-SAT's FEASIBLE means "stopped before proving
@@ -135,7 +137,7 @@ def run_model(model: LinearModel, icosts: np.ndarray, options: SolveOptions, *,
               time_limit: float | None = None) -> dict[str, Any]:
     """Fill a CP-SAT model with ``model``'s rows and the integer costs ``icosts`` and
     solve it in this process; what the result needs, as plain values (the same in a
-    child process, :mod:`.limited`).  ``time_limit`` replaces the options' limit (what
+    worker process, :mod:`.limited`).  ``time_limit`` replaces the options' limit (what
     is left of it)."""
     from ortools.sat.python import cp_model
 
@@ -189,6 +191,7 @@ class CpSatBackend(Backend):
 
     name = "ortools-cpsat"
     module = "ortools"
+    imports = ("ortools.sat.python.cp_model", "scipy.sparse")
     distribution = "ortools"
     description = "OR-Tools CP-SAT on the exact-cover ILP, costs scaled to integers"
     lp = False
@@ -246,13 +249,20 @@ class CpSatBackend(Backend):
             info["cpsat_bound"] = out["bound"]
             # Bound on the scaled problem -> valid bound on the original costs.
             result.bound = out["bound"] / scale - n_rows * max_err
-        result.status, result.message = self._status(name, out, max_err, options)
+            true_cost = math.fsum(model.c[out["selected"]].tolist())
+            info["rounding_gap"] = relative_gap(true_cost, result.bound)
+        result.status, result.message = self._status(name, out, max_err, options,
+                                                     info.get("rounding_gap"))
         return result
 
     @staticmethod
     def _status(name: str, out: dict[str, Any], max_err: float,
-                options: SolveOptions) -> tuple[Status, str]:
-        """Map CP-SAT's status through ``_STATUS_TABLE``, then refine OPTIMAL."""
+                options: SolveOptions, rounding_gap: float | None = None
+                ) -> tuple[Status, str]:
+        """Map CP-SAT's status through ``_STATUS_TABLE``, then refine OPTIMAL.
+
+        ``rounding_gap``: the relative gap between the solution's cost in the
+        original costs and the rounding-corrected bound."""
         status = from_table(_STATUS_TABLE, name)
         message = f"CP-SAT: {name}"
         if name == "MODEL_INVALID":
@@ -261,6 +271,11 @@ class CpSatBackend(Backend):
             return status, message
         gap = relative_gap(out["objective"], out["bound"])
         if max_err > 0.0:
+            if rounding_gap is not None and rounding_gap <= GAP_ZERO:
+                return Status.OPTIMAL, (
+                    f"CP-SAT: OPTIMAL for costs rounded to 1/scale (max rounding error "
+                    f"{max_err:.3g}); the bound corrected for the rounding is within "
+                    f"relative gap {rounding_gap:.3g} of the original costs' objective")
             return Status.FEASIBLE, (
                 f"CP-SAT: optimal for costs rounded to 1/scale (max rounding error "
                 f"{max_err:.3g}); only near-optimal for the original costs, bound "

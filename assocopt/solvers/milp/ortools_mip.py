@@ -136,7 +136,7 @@ def _parameter_text(backend: str, options: SolveOptions, is_mip: bool,
 def run_model(model: LinearModel, backend: str, text: str, options: SolveOptions, *,
               time_limit: float | None = None) -> dict[str, Any]:
     """Solve ``model`` with OR-Tools' ``backend`` (parameter text ``text``) in this
-    process; what the result needs, as plain values (the same in a child process,
+    process; what the result needs, as plain values (the same in a worker process,
     :mod:`.limited`).  ``time_limit`` replaces the options' limit (what is left)."""
     from ortools.linear_solver.python import model_builder_helper as mbh
 
@@ -186,6 +186,7 @@ class OrtoolsMipBackend(Backend):
 
     name = "ortools-mip"
     module = "ortools"
+    imports = ("ortools.linear_solver.pywraplp", "scipy.sparse")
     distribution = "ortools"
     description = "OR-Tools model_builder (SCIP MIP / GLOP LP), model passed as one CSR matrix"
     lp = True

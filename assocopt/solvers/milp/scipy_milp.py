@@ -39,6 +39,7 @@ class ScipyMilpBackend(Backend):
 
     name = "scipy"
     module = "scipy"
+    imports = ("scipy.optimize", "scipy.sparse")
     distribution = "scipy"
     description = "scipy.optimize.milp (HiGHS bundled with scipy)"
     lp = True
@@ -84,7 +85,7 @@ def run_model(model: LinearModel, opts: dict[str, object], *,
               time_limit: float | None = None) -> dict[str, Any]:
     """``scipy.optimize.milp`` on ``model`` in this process (in a worker thread, so that
     Ctrl-C takes effect at once; the abandoned solve ends on its own, see
-    :mod:`.interruptible`), its result as plain values (the same in a child process,
+    :mod:`.interruptible`), its result as plain values (the same in a worker process,
     :mod:`.limited`)."""
     from scipy.optimize import Bounds, LinearConstraint, milp
 

@@ -28,6 +28,7 @@ class ScipyLsaBackend(Backend):
 
     name = "scipy-lsa"
     module = "scipy"
+    imports = ("scipy.optimize",)
     distribution = "scipy"
     description = ("scipy.optimize.linear_sum_assignment, 2-D only (the dense matrix kept; "
                    "miss costs by clipped reduced costs) / compiled sparse LAP (gated "

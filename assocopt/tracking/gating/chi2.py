@@ -98,7 +98,9 @@ def predict_measurements(x: ArrayLike, P: ArrayLike, H: ArrayLike,
     """Predicted measurements :math:`H x_i` and covariances :math:`H P_i H^T (+ R)`.
 
     ``x`` is ``(n, d)``, ``P`` is ``(n, d, d)`` or one ``(d, d)``, ``H`` is ``(m, d)``;
-    ``R`` (``(m, m)``) is added when given.
+    ``R`` (``(m, m)``) is added when given.  ``P`` and ``R`` are covariances: each must
+    be symmetric and positive semi-definite (an indefinite or negative-definite one is
+    an error, not a silently wrong gate).
 
     >>> z, S = predict_measurements([[1.0, 0.5]], np.eye(2), [[1.0, 0.0]], [[0.1]])
     >>> z.tolist(), S.tolist()
@@ -109,6 +111,7 @@ def predict_measurements(x: ArrayLike, P: ArrayLike, H: ArrayLike,
         raise InvalidProblemError(f"x must have shape (n, d), got {X.shape}")
     n, d = X.shape
     Pm = _per_item(P, "P", n, d)
+    _check_covariance(P, "P")
     Hm = finite_floats(H, "H")
     if Hm.ndim != 2 or Hm.shape[1] != d:
         raise InvalidProblemError(f"H must have shape (m, {d}), got {Hm.shape}")
@@ -119,6 +122,7 @@ def predict_measurements(x: ArrayLike, P: ArrayLike, H: ArrayLike,
         m = Hm.shape[0]
         if Rm.shape != (m, m):
             raise InvalidProblemError(f"R must have shape ({m}, {m}), got {Rm.shape}")
+        _check_covariance(Rm, "R")
         S = S + Rm
     return z, S
 
@@ -214,6 +218,37 @@ def _per_item(a: ArrayLike, what: str, n: int, k: int) -> np.ndarray:
         raise InvalidProblemError(f"{what} must have shape ({n}, {k}, {k}) or ({k}, {k}), "
                                   f"got {A.shape}")
     return A
+
+
+#: Relative round-off allowed in a covariance's symmetry and smallest eigenvalue.
+_COV_TOL = 1e-9
+
+
+def _check_covariance(a: ArrayLike, what: str) -> None:
+    """Raise unless every ``(k, k)`` matrix of ``a`` is symmetric positive
+    semi-definite (to a relative :data:`_COV_TOL` of its largest entry)."""
+    A = np.asarray(a, dtype=np.float64)
+    if A.ndim == 2:
+        A = A[None]
+    if A.size == 0:
+        return
+    scale = np.abs(A).max(axis=(1, 2))
+    tol = _COV_TOL * np.maximum(scale, np.finfo(np.float64).tiny)
+    asym = np.abs(A - A.transpose(0, 2, 1)).max(axis=(1, 2))
+    bad = np.flatnonzero(asym > tol)
+    if len(bad):
+        i = int(bad[0])
+        where = f"{what}[{i}]" if np.ndim(a) == 3 else what
+        raise InvalidProblemError(f"{where} is not symmetric (largest |{what} - {what}^T| "
+                                  f"entry {asym[i]:.3g}): a covariance must be")
+    low = np.linalg.eigvalsh(A)[:, 0]
+    bad = np.flatnonzero(low < -tol)
+    if len(bad):
+        i = int(bad[0])
+        where = f"{what}[{i}]" if np.ndim(a) == 3 else what
+        kind = "negative definite" if np.linalg.eigvalsh(A[i])[-1] < 0 else "indefinite"
+        raise InvalidProblemError(f"{where} is not positive semi-definite (it is {kind}: "
+                                  f"smallest eigenvalue {low[i]:.6g}); a covariance must be")
 
 
 def _threshold(probability: float, threshold: float | None, m: int) -> float:
