@@ -38,7 +38,7 @@ def test_2d_marginals_sum_to_one_and_equal_enumeration(case, T):
         with pytest.raises(InvalidProblemError, match="no feasible"):
             marginals(p, k=5, temperature=T)
         return
-    m = marginals(p, k=10_000, temperature=T)
+    m = marginals(p, k=10_000, temperature=T, method="kbest")
     assert m.exhaustive
     assert np.allclose(m.candidate, ref, atol=1e-12)
     assert np.allclose(m.pairs.sum(axis=1) + m.row_miss, 1.0)
@@ -49,7 +49,7 @@ def test_2d_marginals_sum_to_one_and_equal_enumeration(case, T):
 
 def test_truncated_kbest_marginals_still_normalised():
     p = AssignmentProblem.two_d(np.random.default_rng(0).random((5, 5)), 0.4, 0.4)
-    m = marginals(p, k=20)
+    m = marginals(p, k=20, method="kbest")
     assert m.hypotheses == 20 and not m.exhaustive
     assert np.allclose(m.pairs.sum(axis=1) + m.row_miss, 1.0)
     exact = marginals(p, method="enumerate")
@@ -58,7 +58,7 @@ def test_truncated_kbest_marginals_still_normalised():
 
 def test_sd_candidate_marginals_cover_each_index_once():
     p = random_problem(np.random.default_rng(4), "sd", sizes=(3, 2, 2))
-    m = marginals(p, k=10_000, solver="highs")
+    m = marginals(p, k=10_000, solver="highs", method="kbest")
     assert m.exhaustive and np.allclose(m.candidate, _direct(p, 1.0), atol=1e-12)
     A = p.coverage_matrix()
     assert np.allclose(A @ m.candidate, 1.0)
@@ -76,3 +76,126 @@ def test_bad_arguments():
         marginals(p, temperature=0)
     with pytest.raises(InvalidProblemError, match="method"):
         marginals(p, method="sample")
+
+
+# --------------------------------------------------------------- clusters and exact
+from assocopt import ProblemTooLargeError  # noqa: E402
+from assocopt.ranking.clusters import clusters  # noqa: E402
+
+
+def _direct_logz(p: AssignmentProblem, T: float) -> float:
+    costs = [math.fsum(p.costs[s].tolist()) for s in enumerate_solutions(p)]
+    lo = min(costs)
+    return math.log(sum(math.exp(-(c - lo) / T) for c in costs)) - lo / T
+
+
+@st.composite
+def any_problem(draw):
+    """A small problem of any family (2-D with misses, dense, axial, gated S-D)."""
+    kind = draw(st.sampled_from(["square", "rect", "miss", "axial3", "sd", "sd"]))
+    rng = np.random.default_rng(draw(st.integers(0, 2**31 - 1)))
+    if kind == "sd":
+        sizes = tuple(int(v) for v in rng.integers(1, 4, size=int(rng.integers(3, 5))))
+        return random_problem(rng, kind, sizes=sizes, keep=float(rng.choice([0.3, 0.6])))
+    return random_problem(rng, kind, forbid=0.3)
+
+
+@settings(max_examples=60, deadline=None)
+@given(any_problem())
+def test_clusters_partition_indices_and_candidates(p):
+    parts = clusters(p)
+    rows = np.concatenate([c.rows for c in parts])
+    cands = np.concatenate([c.candidates for c in parts])
+    assert sorted(rows.tolist()) == list(range(p.n_rows))
+    assert sorted(cands.tolist()) == list(range(p.n_candidates))
+    R = p.entry_rows
+    for c in parts:
+        inside = np.isin(R[c.candidates], c.rows) | (R[c.candidates] < 0)
+        assert inside.all()
+        assert sum(c.sizes(p)) == len(c.rows)
+
+
+@settings(max_examples=80, deadline=None)
+@given(two_d_cases(), st.sampled_from([0.3, 1.0, 5.0]))
+def test_exact_2d_equals_brute_force(case, T):
+    p = AssignmentProblem.two_d(*case)
+    if not any(True for _ in enumerate_solutions(p)):
+        with pytest.raises(InvalidProblemError, match="no feasible"):
+            marginals(p, temperature=T, method="exact")
+        return
+    m = marginals(p, temperature=T, method="exact")
+    assert m.exhaustive and m.error_bound == 0.0
+    assert np.abs(m.candidate - _direct(p, T)).max(initial=0) <= 1e-12
+    assert m.log_partition == pytest.approx(_direct_logz(p, T), abs=1e-12, rel=1e-12)
+    assert np.allclose(m.pairs.sum(axis=1) + m.row_miss, 1.0, atol=1e-12)
+    assert np.allclose(m.pairs.sum(axis=0) + m.col_miss, 1.0, atol=1e-12)
+
+
+@settings(max_examples=60, deadline=None)
+@given(any_problem())
+def test_exact_any_family_equals_brute_force(p):
+    m = marginals(p, method="exact", temperature=2.0)
+    assert np.abs(m.candidate - _direct(p, 2.0)).max(initial=0) <= 1e-12
+    assert m.log_partition == pytest.approx(_direct_logz(p, 2.0), abs=1e-12, rel=1e-12)
+    assert np.allclose(p.coverage_matrix() @ m.candidate, 1.0, atol=1e-12)
+
+
+def test_sd_false_alarm_probabilities_are_the_singletons():
+    p = random_problem(np.random.default_rng(7), "sd", sizes=(3, 3, 2))
+    m = marginals(p, method="exact")
+    ref = _direct(p, 1.0)
+    single = (p.tuples > 0).sum(axis=1) == 1
+    for s in range(3):
+        sel = single & (p.tuples[:, s] > 0)
+        want = np.zeros(p.sizes[s])
+        want[p.tuples[sel, s] - 1] = ref[sel]
+        assert np.allclose(m.unassigned[s], want, atol=1e-12)
+    assert m.pairs is None
+
+
+def _chain(n: int, rng: np.random.Generator) -> AssignmentProblem:
+    """``n`` tracks in a row, track i gating measurements i and i+1, apart in blocks
+    of three tracks (independent clusters)."""
+    C = np.full((n, n + 1), np.inf)
+    for i in range(n):
+        C[i, i:i + 2] = rng.normal(size=2)
+    for b in range(3, n, 3):                 # cut the chain every 3 tracks
+        C[b - 1, b] = np.inf
+    return AssignmentProblem.two_d(C, rng.random(n) + 0.5, rng.random(n + 1) + 0.5)
+
+
+def test_clusters_multiply_and_log_partitions_add():
+    p = _chain(9, np.random.default_rng(3))
+    m = marginals(p, method="exact")
+    assert m.clusters == 3
+    assert np.abs(m.candidate - _direct(p, 1.0)).max() <= 1e-12
+    assert m.log_partition == pytest.approx(_direct_logz(p, 1.0), abs=1e-11)
+
+
+def test_large_entangled_cluster_is_exact_and_budget_is_an_error():
+    rng = np.random.default_rng(5)
+    n = 40                                    # tracks gating 3 neighbouring measurements
+    C = np.full((n, n + 2), np.inf)
+    for i in range(n):
+        C[i, i:i + 3] = rng.normal(size=3)
+    p = AssignmentProblem.two_d(C, 1.0, 1.0)
+    m = marginals(p, method="exact")
+    assert m.clusters == 1 and m.exhaustive and m.nodes > 0
+    assert np.allclose(m.pairs.sum(axis=1) + m.row_miss, 1.0, atol=1e-12)
+    with pytest.raises(ProblemTooLargeError, match=r"cluster of 40 x 42 indices.*max_nodes=50"):
+        marginals(p, method="exact", max_nodes=50)
+
+
+def test_bad_input_is_a_clear_error():
+    with pytest.raises(InvalidProblemError, match="no feasible.*index 1 of axis 0"):
+        marginals(AssignmentProblem.two_d([[np.inf]], np.inf, 0.0), method="exact")
+    with pytest.raises(InvalidProblemError, match="NaN"):
+        marginals(AssignmentProblem.two_d([[np.nan]], 0.0, 0.0))
+    with pytest.raises(InvalidProblemError, match=r"\+inf"):
+        marginals(AssignmentProblem.two_d([[np.inf]], 0.0, 0.0, maximize=True))
+    p = AssignmentProblem.two_d([[0.0]], 0.0, 0.0)
+    for T in (0, -1.0, math.inf, math.nan, True):
+        with pytest.raises(InvalidProblemError, match="temperature"):
+            marginals(p, temperature=T)
+    with pytest.raises(InvalidProblemError, match="max_nodes"):
+        marginals(p, max_nodes=0)
