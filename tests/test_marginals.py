@@ -199,3 +199,72 @@ def test_bad_input_is_a_clear_error():
             marginals(p, temperature=T)
     with pytest.raises(InvalidProblemError, match="max_nodes"):
         marginals(p, max_nodes=0)
+
+
+# ------------------------------------------------------- approximations and bounds
+@settings(max_examples=40, deadline=None)
+@given(st.integers(0, 2**31 - 1), st.sampled_from([1, 3, 10, 30]),
+       st.sampled_from([0.5, 1.0, 3.0]))
+def test_kbest_error_bound_holds_against_exact(seed, k, T):
+    rng = np.random.default_rng(seed)
+    kind = rng.choice(["miss", "sd", "square"])
+    p = random_problem(rng, str(kind), forbid=0.2) if kind != "sd" else \
+        random_problem(rng, "sd", sizes=(3, 3, 3))
+    exact = marginals(p, temperature=T, method="exact")
+    m = marginals(p, k=k, temperature=T, method="kbest")
+    err = np.abs(m.candidate - exact.candidate).max(initial=0)
+    assert err <= m.error_bound + 1e-12
+    assert m.exhaustive == (m.error_bound == 0.0)
+    if m.exhaustive:
+        assert err <= 1e-12
+    assert m.log_partition <= exact.log_partition + 1e-9
+
+
+def _tree(rng: np.random.Generator) -> AssignmentProblem:
+    """Tracks on a line, each gating its own measurement and the next one: a
+    cycle-free association graph, on which belief propagation is exact."""
+    n = 7
+    C = np.full((n, n + 1), np.inf)
+    for i in range(n):
+        C[i, i:i + 2] = rng.normal(size=2)
+    return AssignmentProblem.two_d(C, rng.random(n) + 0.2, rng.random(n + 1) + 0.2)
+
+
+def test_lbp_is_exact_on_a_tree_and_reports_its_iterations():
+    p = _tree(np.random.default_rng(11))
+    exact = marginals(p, method="exact")
+    m = marginals(p, method="lbp", tolerance=1e-13)
+    assert np.abs(m.candidate - exact.candidate).max() < 1e-9
+    assert m.iterations >= 2 and m.residual <= 1e-13 and not m.exhaustive
+    assert math.isnan(m.error_bound)
+    assert np.allclose(m.pairs.sum(axis=1) + m.row_miss, 1.0)
+    short = marginals(p, method="lbp", max_iterations=1)
+    assert short.iterations == 1 and short.residual > 1e-13
+
+
+def test_lbp_close_on_loopy_clusters_and_refuses_what_it_cannot_do():
+    rng = np.random.default_rng(2)
+    C = rng.normal(size=(4, 4)) + 2.0
+    p = AssignmentProblem.two_d(C, 1.0, 1.0)
+    err = np.abs(marginals(p, method="lbp").candidate
+                 - marginals(p, method="exact").candidate).max()
+    assert 0 < err < 0.1
+    with pytest.raises(InvalidProblemError, match="column 1 is not"):
+        marginals(AssignmentProblem.dense(C), method="lbp")
+    with pytest.raises(InvalidProblemError, match="2-D"):
+        marginals(random_problem(rng, "sd", sizes=(2, 2, 2)), method="lbp")
+
+
+def test_auto_falls_back_to_kbest_with_a_bound_and_a_warning():
+    rng = np.random.default_rng(5)
+    n = 12
+    C = np.full((n, n + 2), np.inf)
+    for i in range(n):
+        C[i, i:i + 3] = rng.normal(size=3)
+    p = AssignmentProblem.two_d(C, 1.0, 1.0)
+    exact = marginals(p)
+    assert exact.method == "auto" and exact.exhaustive and exact.approximated == 0
+    with pytest.warns(RuntimeWarning, match="within"):
+        m = marginals(p, k=5, max_nodes=20)
+    assert m.approximated == 1 and m.error_bound > 1e-3 and not m.exhaustive
+    assert np.abs(m.candidate - exact.candidate).max() <= m.error_bound

@@ -65,7 +65,8 @@ def cluster_ranked(problem: AssignmentProblem, cluster: Cluster, k: int, T: floa
         except ProblemTooLargeError as exc:
             raise ProblemTooLargeError(
                 f"method='enumerate' is for small clusters: {exc.args[0].split(';')[0]}; "
-                "use method='exact' instead") from None
+                "use method='kbest' (the k best, with an error bound) or method='exact' "
+                "instead") from None
         exhausted = True
     else:
         from .kbest import kbest
