@@ -135,6 +135,7 @@ def test_exact_2d_equals_brute_force(case, T):
 @given(any_problem())
 def test_exact_any_family_equals_brute_force(p):
     m = marginals(p, method="exact", temperature=2.0)
+    assert m.clusters == len(clusters(p))
     assert np.abs(m.candidate - _direct(p, 2.0)).max(initial=0) <= 1e-12
     assert m.log_partition == pytest.approx(_direct_logz(p, 2.0), abs=1e-12, rel=1e-12)
     assert np.allclose(p.coverage_matrix() @ m.candidate, 1.0, atol=1e-12)

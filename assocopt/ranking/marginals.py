@@ -129,40 +129,59 @@ def marginals(problem: AssignmentProblem, k: int = 100, temperature: float = 1.0
         P, it, res = lbp_marginals(problem, logw, tolerance, max_iterations)
         return _result(problem, P, 0, False, T, math.nan, "lbp", math.nan, it, res,
                        len(_clusters(problem)), len(_clusters(problem)), 0)
+    if method in ("exact", "auto"):
+        return _exact(problem, logw, k, T, solver, method, max_nodes)
     P = np.zeros(problem.n_candidates)
     log_z = 0.0
-    hyps = nodes = approx = 0
+    hyps = approx = 0
     bound = 0.0
     parts = _clusters(problem)
     for cl in parts:
-        if method in ("exact", "auto"):
-            from ..runtime.errors import ProblemTooLargeError
-            from .hypothesis_net import cluster_marginals
-
-            try:
-                lz, p, nn = cluster_marginals(problem, cl, logw, max_nodes)
-                nodes = max(nodes, nn)
-                h, b = 0, 0.0
-            except ProblemTooLargeError:
-                if method == "exact":
-                    raise
-                lz, p, h, b = _ranked(problem, cl, k, T, solver, "kbest")
-                approx += b > 0
-        else:
-            lz, p, h, b = _ranked(problem, cl, k, T, solver, method)
-            approx += b > 0
+        lz, p, h, b = _ranked(problem, cl, k, T, solver, method)
         if not lz > -math.inf:
             raise InvalidProblemError("the problem has no feasible solution: no marginals")
+        approx += b > 0
         P[cl.candidates] = p
         log_z += lz
         hyps += h
         bound = max(bound, b)
-    if method == "auto" and bound > WARN_BOUND:
-        warnings.warn(f"marginals: {approx} of {len(parts)} clusters are too large for the "
-                      f"exact net (max_nodes={max_nodes}); their k-best sums (k={k}) are "
-                      f"within {bound:.3g} only", RuntimeWarning, stacklevel=2)
     return _result(problem, P, hyps, bound == 0.0, T, log_z, method, bound, 0, 0.0,
-                   len(parts), approx, nodes)
+                   len(parts), approx, 0)
+
+
+def _exact(problem: AssignmentProblem, logw: np.ndarray, k: int, T: float, solver: str,
+           method: str, max_nodes: int) -> Marginals:
+    """``exact`` / ``auto``: every cluster by its net, or (``auto``) by k-best sums
+    with their bound where the net does not fit."""
+    from ..runtime.errors import ProblemTooLargeError
+    from .hypothesis_net import exact_marginals, too_large
+
+    ex = exact_marginals(problem, logw, max_nodes)
+    if (ex.status == 2).any():
+        raise InvalidProblemError("the problem has no feasible solution: no marginals")
+    P = ex.P
+    log_z = float(ex.log_z[ex.status == 0].sum())
+    hyps = approx = 0
+    bound = 0.0
+    for c in np.flatnonzero(ex.status != 0):
+        cl = ex.cluster(int(c))
+        if method == "exact":
+            raise ProblemTooLargeError(too_large(problem, cl, int(ex.status[c]),
+                                                 int(ex.width[c]), max_nodes))
+        lz, p, h, b = _ranked(problem, cl, k, T, solver, "kbest")
+        if not lz > -math.inf:
+            raise InvalidProblemError("the problem has no feasible solution: no marginals")
+        approx += b > 0
+        P[cl.candidates] = p
+        log_z += lz
+        hyps += h
+        bound = max(bound, b)
+    if bound > WARN_BOUND:
+        warnings.warn(f"marginals: {approx} of {len(ex.log_z)} clusters are too large for "
+                      f"the exact net (max_nodes={max_nodes}); their k-best sums (k={k}) "
+                      f"are within {bound:.3g} only", RuntimeWarning, stacklevel=3)
+    return _result(problem, P, hyps, bound == 0.0, T, log_z, method, bound, 0, 0.0,
+                   len(ex.log_z), approx, int(ex.nodes.max(initial=0)))
 
 
 def _ranked(problem: AssignmentProblem, cl, k: int, T: float, solver: str, method: str
