@@ -269,3 +269,10 @@ def test_auto_falls_back_to_kbest_with_a_bound_and_a_warning():
         m = marginals(p, k=5, max_nodes=20)
     assert m.approximated == 1 and m.error_bound > 1e-3 and not m.exhaustive
     assert np.abs(m.candidate - exact.candidate).max() <= m.error_bound
+
+
+def test_a_frontier_over_64_bits_is_an_error_naming_the_cluster():
+    C = np.random.default_rng(1).random((70, 70))      # every pair allowed: one cluster
+    p = AssignmentProblem.two_d(C, 1.0, 1.0)
+    with pytest.raises(ProblemTooLargeError, match="cluster of 70 x 70 indices.*64"):
+        marginals(p, method="exact")

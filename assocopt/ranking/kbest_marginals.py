@@ -11,8 +11,12 @@ differ by at most ``R / (Z_k + R)`` (the two extremes ``R_c = R`` and ``R_c = 0`
 a bound on the number of hypotheses: a hypothesis is fixed by the candidate covering
 each index of all axes but one (the indices of the last axis not covered so are
 covered by their singletons), so ``H <= prod deg(i)`` over the indices of every axis
-but the one with the largest such product.  A ranking that ran out (``exhausted``)
-has ``R = 0``.
+but the one with the largest such product.  For a 2-D cluster whose columns may all
+stay unassigned a second bound holds: with each pair's weight taken relative to its
+column's miss, a hypothesis is a choice of one option (a column or the miss) per row,
+so ``Z <= prod_j w(miss_j) * prod_i (w'(i, miss) + sum_j w'(i, j))`` =: ``Z_up`` and
+``R <= Z_up - Z_k``, giving the bound ``1 - Z_k / Z_up``; the smaller of the two is
+reported.  A ranking that ran out (``exhausted``) has ``R = 0``.
 """
 
 from __future__ import annotations
@@ -91,4 +95,29 @@ def cluster_ranked(problem: AssignmentProblem, cluster: Cluster, k: int, T: floa
             if log_h < 700 else log_h
         log_r = left + float(logw.min())                     # the k-th weight is the least
         bound = 1.0 / (1.0 + math.exp(min(log_z - log_r, 700.0)))
+        log_up = _log_z_upper(sub, T)
+        if log_up is not None:
+            bound = min(bound, max(0.0, -math.expm1(min(log_z - log_up, 0.0))))
     return log_z, P, len(sels), bound
+
+
+def _log_z_upper(sub: AssignmentProblem, T: float) -> float | None:
+    """log ``Z_up`` of a 2-D cluster whose columns may all stay unassigned (module
+    docstring), else None."""
+    if sub.ndim != 2:
+        return None
+    n1, n2 = sub.sizes
+    tup = sub.tuples
+    lw = -np.asarray(sub.costs) / T
+    cmiss = tup[:, 0] == 0
+    lcm = np.full(n2, -np.inf)
+    lcm[tup[cmiss, 1] - 1] = lw[cmiss]
+    if not np.isfinite(lcm).all():
+        return None
+    rows = tup[~cmiss, 0] - 1
+    rel = lw[~cmiss] - np.where(tup[~cmiss, 1] > 0, lcm[np.maximum(tup[~cmiss, 1] - 1, 0)], 0.0)
+    top = np.full(n1, -np.inf)
+    np.maximum.at(top, rows, rel)
+    acc = np.zeros(n1)
+    np.add.at(acc, rows, np.exp(rel - top[rows]))
+    return float(lcm.sum() + (top + np.log(acc)).sum())
