@@ -127,8 +127,9 @@ def marginals(problem: AssignmentProblem, k: int = 100, temperature: float = 1.0
         from .lbp import lbp_marginals
 
         P, it, res = lbp_marginals(problem, logw, tolerance, max_iterations)
+        n_parts = len(_clusters(problem))
         return _result(problem, P, 0, False, T, math.nan, "lbp", math.nan, it, res,
-                       len(_clusters(problem)), len(_clusters(problem)), 0)
+                       n_parts, n_parts, 0)
     if method in ("exact", "auto"):
         return _exact(problem, logw, k, T, solver, method, max_nodes)
     P = np.zeros(problem.n_candidates)

@@ -119,7 +119,6 @@ def exact_marginals(E, logw, n, max_nodes):
         rows = row_of[row_ptr[c]:row_ptr[c + 1]]
         nc = len(rows)
         # ---- order
-        order = np.empty(nc, np.int64)
         best = rows[0]
         for y in rows:
             if inc_ptr[y + 1] - inc_ptr[y] < inc_ptr[best + 1] - inc_ptr[best]:
@@ -151,7 +150,6 @@ def exact_marginals(E, logw, n, max_nodes):
                         if pos[y] < 0:
                             best = y
                             break
-            order[step] = best
             pos[best] = step
             if fidx[best] >= 0:                      # out of the frontier: swap-remove
                 last = front[nf - 1]
