@@ -276,3 +276,19 @@ def test_a_frontier_over_64_bits_is_an_error_naming_the_cluster():
     p = AssignmentProblem.two_d(C, 1.0, 1.0)
     with pytest.raises(ProblemTooLargeError, match="cluster of 70 x 70 indices.*64"):
         marginals(p, method="exact")
+
+
+def test_a_net_larger_than_its_first_work_arrays_is_the_same_either_way_round():
+    """Every track gates every measurement: a net of over 65 536 nodes (the build
+    restarts with larger work arrays); the transposed problem (measurements first) is
+    another net over other states, and must give the same probabilities."""
+    rng = np.random.default_rng(8)
+    C = rng.normal(size=(13, 14))
+    rm, cm = rng.random(13), rng.random(14)
+    m = marginals(AssignmentProblem.two_d(C, rm, cm), method="exact")
+    t = marginals(AssignmentProblem.two_d(C.T, cm, rm), method="exact")
+    assert m.nodes > 65_536
+    assert np.abs(m.pairs - t.pairs.T).max() < 1e-12
+    assert np.abs(m.row_miss - t.col_miss).max() < 1e-12
+    assert m.log_partition == pytest.approx(t.log_partition, rel=1e-13)
+    assert np.allclose(m.pairs.sum(axis=1) + m.row_miss, 1.0, atol=1e-12)
