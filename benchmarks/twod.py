@@ -283,7 +283,7 @@ def marginal_rows(ks: list[int], seeds: int) -> list[dict]:
         for k in ks:
             errs, masses = [], []
             for p, exact in zip(problems, exacts):
-                approx = marginals(p, k=k, temperature=T)
+                approx = marginals(p, k=k, temperature=T, method="kbest")
                 errs.append(float(np.abs(approx.candidate - exact.candidate).max()))
                 masses.append(float(math.exp(approx.log_partition - exact.log_partition)))
             rows.append({"temperature": T, "k": k, "problems": seeds,

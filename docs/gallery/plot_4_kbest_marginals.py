@@ -25,7 +25,7 @@ for rank, sol in enumerate(ranked, start=1):
 print("every assignment ranked:", ranked.exhausted)
 
 # %%
-m = marginals(problem, k=200, temperature=1.0)
+m = marginals(problem, k=200, temperature=1.0, method="kbest")
 print("each track's probabilities (pairs + miss) sum to",
       np.round(m.pairs.sum(axis=1) + m.row_miss, 6))
 

@@ -4,7 +4,8 @@ rule of both Lagrangian back ends (:mod:`.dominance`), the sparse 2-D LAP
 (:mod:`.sparse_lap`, imported by :mod:`assocopt.solvers.twod.sparse`) and the 2-D ranking
 of :func:`assocopt.kbest` (:mod:`.sap`: a warm-startable shortest-augmenting-path LAP
 on dense matrices, :mod:`.murty2d`: Murty's method on it, imported by
-:mod:`assocopt.ranking.kbest2d`); imported only when one of them runs (importing numba
+:mod:`assocopt.ranking.kbest2d`) and the exact marginals' hypothesis net
+(:mod:`.ehm_net`, imported by :mod:`assocopt.ranking.hypothesis_net`); imported only when one of them runs (importing numba
 costs half a second). :mod:`assocopt.solvers.bnb.kernels` is the import point of the
 ``bnb`` kernels.
 
