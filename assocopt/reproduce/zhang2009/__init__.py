@@ -10,8 +10,9 @@ Four experiments, each with its own results store ``OUT/zhang2009-*.sqlite``:
                  for 1a; not given for 2, presumably the same).
 ``weights``      MM-WA versus MM-NCR over k = 1..10 with the paper's w and r
                  matrices, truncation decision (Experiment 1b, Fig. 3).
-``table1``       decision time versus P_d: MD-ND, MD-2DA solved by the default 2-D
-                 back end (scipy's linear_sum_assignment) and by HiGHS (ILP).
+``table1``       decision time versus P_d: MD-ND, MD-2DA solved by the default back
+                 end (``auto``, which picks scipy's linear_sum_assignment for these
+                 2-D problems) and by HiGHS (ILP).
 ``sensitivity``  ours: MD-2DA's gate level alpha, tau = 0, and the alternative
                  readings of truncation (dendrogram ordering, same-sensor
                  pi = 0) at three noise levels.
