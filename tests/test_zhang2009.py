@@ -282,6 +282,26 @@ def test_reproduction_same_numbers_with_two_workers(tmp_path):
     assert pick(one) == pick(two)
 
 
+def test_a_run_of_some_parts_keeps_the_others_from_the_summary(tmp_path):
+    """Rerunning only the parts whose code changed keeps the other parts' records (and
+    their paired rows and compute times) from the folder's summary.json, in part order;
+    a summary of another seed is refused."""
+    from assocopt.reproduce import zhang2009 as repro
+    quiet = lambda t: None
+    full = repro.run(2, 1, 3, tmp_path, parts=("weights", "sensitivity"), echo=quiet)
+    (tmp_path / "zhang2009-sensitivity.sqlite").unlink()       # recomputed from scratch
+    again = repro.run(2, 1, 3, tmp_path, parts=("sensitivity",), echo=quiet)
+    assert again["kept_parts"] == ["main", "weights", "table1", "table1-enum"]
+    stable = lambda recs: [r for r in recs if not r["volatile"]]      # timings vary
+    assert stable(again["records"]) == stable(full["records"]) and stable(full["records"])
+    assert again["paired"] == full["paired"]
+    assert set(again["trial_seconds"]) == {"zhang2009-weights", "zhang2009-sensitivity"}
+    with pytest.raises(ValueError, match="other runs, seed or parameters"):
+        repro.run(2, 1, 4, tmp_path, parts=("sensitivity",), echo=quiet)
+    with pytest.raises(ValueError, match="unknown zhang2009 part"):
+        repro.experiments(2, 0, parts=("table2",))
+
+
 def test_reproduction_rejects_unknown_options():
     from assocopt.reproduce import zhang2009 as repro
     with pytest.raises(ValueError, match="unknown zhang2009 option"):
