@@ -9,6 +9,7 @@ from the package by ``docs/_ext/assocopt_api.py``.
 
 from __future__ import annotations
 
+import re
 import sys
 from pathlib import Path
 
@@ -84,3 +85,20 @@ html_theme_options = {
 }
 html_sidebars = {"index": []}
 html_show_sourcelink = False
+
+
+# -- Paper tables ----------------------------------------------------------------
+# Each paper's NAME/tables.md (the run's full tables, written by the reproduction) is
+# built and linked from its paper page, but listed in no toctree, so the section
+# navigation shows the papers, not their tables: the page is marked orphan here,
+# leaving the generated file exactly as the reproduction writes it.
+_PAPER_TABLES = re.compile(r"papers/[\w-]+/tables")
+
+
+def _orphan_paper_tables(app, docname: str, source: list[str]) -> None:
+    if _PAPER_TABLES.fullmatch(docname):
+        source[0] = "---\norphan: true\n---\n" + source[0]
+
+
+def setup(app):
+    app.connect("source-read", _orphan_paper_tables)

@@ -531,6 +531,7 @@ def test_page_tables_match_the_committed_summary():
     assert summary["runs"] == 200 and summary["seed"] == 0
     text = PAGE.read_text(encoding="utf-8")
     assert page_block(text, "example") == repro.render_example().strip()
+    assert page_block(text, "run") == repro.render_run(summary).strip()
     # the tuning grid and its best pairs are in the summary, and the tuned methods were
     # re-run in the main comparison and the sweep
     assert summary["tuned"] == repro.best_pairs(summary["records"])

@@ -154,6 +154,38 @@ def test_md2da_every_exact_backend_gives_the_same_decisions(name, cost):
         assert res.solution.objective == pytest.approx(ref.solution.objective, abs=1e-7)
 
 
+def _experiment_trials(f: float, n: int):
+    """The first ``n`` simulated runs of the f sweep of the committed experiment at ``f``
+    (their measures pi, sensors and truths)."""
+    from assocopt.experiments import trial_seed
+    from assocopt.reproduce import zhang2009 as repro
+    from assocopt.reproduce.zhang2009.experiment import _measure_params
+    exp = repro.experiments(1, 0, parts=("main",))[0]
+    st = [s for s in exp.settings if s["sweep"] == "f" and s["f"] == f][0]
+    params = _measure_params(st, "ncr", st["same_sensor"])
+    for t in range(n):
+        rng = np.random.default_rng(trial_seed(0, st, t))
+        d = Zhang2009(f=f, p_d=st["p_d"], region=tuple(st["region"])).simulate(rng)
+        yield matching_matrix(d.observations, params), d.observations.sensor, d.truth
+
+
+@pytest.mark.parametrize("name", [installed(n) for n in EXACT] + ["auto"])
+def test_md2da_tau_zero_same_accuracy_on_every_exact_backend(name):
+    """tau = 0 has no non-assignment option (a tie between "unpaired" and "paired at
+    pi = 0" would leave the answer to each back end's tie rule): on the experiment's own
+    runs at f = 0.05 and 0.3 every exact back end decides min(N1, N2) pairs with the
+    same accuracy as scipy-lsa."""
+    from assocopt.tracking.belief.group_matching import correct_match_rate
+    for f in (0.05, 0.3):
+        for pi, sensor, truth in _experiment_trials(f, 8):
+            ref = md_2da(pi, sensor, tau=0.0, solver="scipy-lsa")
+            res = md_2da(pi, sensor, tau=0.0, solver=name)
+            assert len(res.relations.pairs) == min((sensor == 1).sum(), (sensor == 2).sum())
+            assert res.solution.objective == pytest.approx(ref.solution.objective, abs=1e-9)
+            assert (correct_match_rate(res.relations, truth) ==
+                    correct_match_rate(ref.relations, truth)), (name, f)
+
+
 def test_md2da_bruteforce_agrees_on_small_scenarios():
     rng = np.random.default_rng(9)
     for _ in range(6):
@@ -248,6 +280,26 @@ def test_reproduction_same_numbers_with_two_workers(tmp_path):
     pick = lambda s: sorted((r["setting"]["k"], r["method"], r["metric"], r["value"])
                             for r in s["records"] if not r["volatile"])
     assert pick(one) == pick(two)
+
+
+def test_a_run_of_some_parts_keeps_the_others_from_the_summary(tmp_path):
+    """Rerunning only the parts whose code changed keeps the other parts' records (and
+    their paired rows and compute times) from the folder's summary.json, in part order;
+    a summary of another seed is refused."""
+    from assocopt.reproduce import zhang2009 as repro
+    quiet = lambda t: None
+    full = repro.run(2, 1, 3, tmp_path, parts=("weights", "sensitivity"), echo=quiet)
+    (tmp_path / "zhang2009-sensitivity.sqlite").unlink()       # recomputed from scratch
+    again = repro.run(2, 1, 3, tmp_path, parts=("sensitivity",), echo=quiet)
+    assert again["kept_parts"] == ["main", "weights", "table1", "table1-enum"]
+    stable = lambda recs: [r for r in recs if not r["volatile"]]      # timings vary
+    assert stable(again["records"]) == stable(full["records"]) and stable(full["records"])
+    assert again["paired"] == full["paired"]
+    assert set(again["trial_seconds"]) == {"zhang2009-weights", "zhang2009-sensitivity"}
+    with pytest.raises(ValueError, match="other runs, seed or parameters"):
+        repro.run(2, 1, 4, tmp_path, parts=("sensitivity",), echo=quiet)
+    with pytest.raises(ValueError, match="unknown zhang2009 part"):
+        repro.experiments(2, 0, parts=("table2",))
 
 
 def test_reproduction_rejects_unknown_options():

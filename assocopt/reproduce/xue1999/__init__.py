@@ -37,11 +37,11 @@ from .experiment import (DEFAULTS, LABELS, PAPER_CLAIMS, _options, _scenario,  #
                          _tracker, best_pairs, experiments, label, parameters, trial)
 from .figures import make_figures
 from .report import (lookup, render_example, render_headline,  # noqa: F401
-                     render_parameters, render_tables)
+                     render_parameters, render_run, render_tables)
 
 __all__ = ["DEFAULTS", "PAPER_CLAIMS", "LABELS", "METHODS", "experiments", "trial",
            "parameters", "run", "render_tables", "render_parameters", "render_headline",
-           "render_example", "make_figures", "label", "best_pairs"]
+           "render_run", "render_example", "make_figures", "label", "best_pairs"]
 
 _PARTS = ("tune", "main", "sweep")
 

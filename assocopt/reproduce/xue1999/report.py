@@ -14,7 +14,7 @@ from .._report import mean_ci, wall_time_line
 from .experiment import LABELS, METRICS, label
 
 __all__ = ["lookup", "ordered", "render_tables", "render_parameters", "render_headline",
-           "render_example", "two_record_example"]
+           "render_run", "render_example", "two_record_example"]
 
 _HEAD = {"correct_rate": "correct association rate", "decision_precision":
          "decision precision", "swaps": "track swaps", "false_tracks": "false tracks",
@@ -160,27 +160,51 @@ def render_parameters(summary: Mapping[str, Any]) -> str:
 
 
 def render_headline(summary: Mapping[str, Any]) -> str:
-    """The key numbers quoted in the page's text."""
+    """The key numbers quoted in the page's text: each tuned method at its best (B, M')
+    first (the tuned best leads), then the baselines, then every other method (the
+    untuned pair B = 0.2, M' = 6 and the variants), then the range over the tuning grid."""
     recs = summary["records"]
     main = {m: {k[0]: v for k, v in lookup(recs, "main", m).items()}
             for m in ("correct_rate", "decision_precision", "swaps", "false_tracks")}
-    L = []
-    for m in ordered(main["correct_rate"]):
-        L.append(f"- {label(m)}: correct association rate {_ci(main['correct_rate'][m])}, "
-                 f"decision precision {main['decision_precision'][m][0]:.3f}, "
-                 f"{main['swaps'][m][0]:.2f} track swaps and {main['false_tracks'][m][0]:.2f} "
-                 "false tracks per run")
+    tuned = [b["method"] for b in summary.get("tuned", {}).values()
+             if b["method"] in main["correct_rate"]]
+    baselines = [m for m in ("gnn", "nn") if m in main["correct_rate"]]
+    rest = [m for m in ordered(main["correct_rate"]) if m not in tuned + baselines]
+
+    def line(m: str, prefix: str = "") -> str:
+        return (f"- {prefix}{label(m)}: correct association rate "
+                f"{_ci(main['correct_rate'][m])}, decision precision "
+                f"{main['decision_precision'][m][0]:.3f}, {main['swaps'][m][0]:.2f} track "
+                f"swaps and {main['false_tracks'][m][0]:.2f} false tracks per run")
+    L = [line(m, "tuned: ") for m in ordered(tuned)] + [line(m) for m in baselines]
+    L += [line(m) for m in rest]
     for m, b in summary.get("tuned", {}).items():
         lo, hi = b["range"]
         L.append(f"- {LABELS[m]}, over the tuning grid ({summary['tune_runs']} runs): correct "
                  f"association rate from {lo:.3f} to {hi:.3f}, best at B = {b['B']:g}, "
-                 f"M′ = {b['M_prime']:g}")
+                 f"M′ = {b['M_prime']:g}{_edge(summary, b)}")
+    return "\n".join(L)
+
+
+def _edge(summary: Mapping[str, Any], best: Mapping[str, Any]) -> str:
+    """" (at the grid's edge in B / M')" when the best pair lies on the tuning grid's
+    border (the optimum may then lie outside it), else nothing."""
+    grid = summary["parameters"]["ours"]["tuning"]
+    edges = [name for name, key, values in (("B", "B", grid["B"]),
+                                            ("M′", "M_prime", grid["M_prime"]))
+             if best[key] in (min(values), max(values))]
+    return f" (at the grid's edge in {' and '.join(edges)})" if edges else ""
+
+
+def render_run(summary: Mapping[str, Any]) -> str:
+    """The run's bookkeeping for the page's closing section: run counts and wall times."""
     t = summary["timing"]
     parts = [f"{p} {t[f'xue1999-{p}']['wall_s']:.0f} s" for p in ("tune", "main", "sweep")
              if f"xue1999-{p}" in t]
-    L.append(f"- wall time of the full run: {summary['wall_s']:.0f} s with "
-             f"{summary['workers']} worker processes ({', '.join(parts)})")
-    return "\n".join(L)
+    return (f"- runs: {summary['runs']} of the base scene, {summary['tune_runs']} per point "
+            f"of the tuning grid and {summary['sweep_runs']} per point of the sweep, seed {summary['seed']}\n"
+            f"- wall time of the full run: {summary['wall_s']:.0f} s with "
+            f"{summary['workers']} worker processes ({', '.join(parts)})")
 
 
 #: Stage-1 states s_on of the two-record example, factors (x, y, vx, vy, IFF).

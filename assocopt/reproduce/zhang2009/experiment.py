@@ -22,7 +22,7 @@ from ...tracking.belief.group_matching import (MeasureParams, Relations, correct
                                         matching_matrix, pair_components)
 from ...tracking.scenarios.zhang2009 import OURS, PAPER, Zhang2009
 
-__all__ = ["W", "R", "PAPER_TABLE1", "PAPER_CLAIMS", "DEFAULTS", "METHODS", "experiments",
+__all__ = ["W", "R", "PAPER_TABLE1", "PAPER_CLAIMS", "DEFAULTS", "METHODS", "PARTS", "experiments",
            "trial", "parameters", "run", "render_tables", "make_figures"]
 
 #: Experiment 1b (§5.1): MM-WA weights w(1,k), w(2,k) and MM-NCR reliabilities r(1,k), r(2,k).
@@ -200,10 +200,16 @@ def _options(options: Mapping[str, Any] | None) -> dict[str, Any]:
     return opts
 
 
+#: The parts of the reproduction, one Experiment each, in the order they run.
+PARTS = ("main", "weights", "table1", "table1-enum", "sensitivity")
+
+
 def experiments(runs: int, seed: int, options: Mapping[str, Any] | None = None,
-                parts: Sequence[str] = ("main", "weights", "table1", "sensitivity")
-                ) -> list[Experiment]:
+                parts: Sequence[str] = PARTS) -> list[Experiment]:
     """The Experiments of the reproduction (``options`` override :data:`DEFAULTS`)."""
+    unknown = set(parts) - set(PARTS)
+    if unknown:
+        raise ValueError(f"unknown zhang2009 part(s) {sorted(unknown)}; valid: {list(PARTS)}")
     o = _options(options)
     common = {k: (list(o[k]) if k == "region" else o[k])
               for k in _SCENARIO_KEYS + ("r_p", "r_a", "alpha", "cost", "solver",
@@ -226,6 +232,7 @@ def experiments(runs: int, seed: int, options: Mapping[str, Any] | None = None,
                     for p in TABLE1_PD]
         out.append(Experiment("zhang2009-table1", settings, TABLE1_METHODS, trial, runs, seed,
                               params={"experiment": "table1"}, volatile=VOLATILE))
+    if "table1-enum" in parts:
         settings = [{"sweep": "table1", "f": o["f_fixed"], "p_d": p,
                      "enum_max_nodes": int(o["enum_max_nodes"]), **common} for p in TABLE1_PD]
         out.append(Experiment("zhang2009-table1-enum", settings, ("ncr+2da-enum",), trial,

@@ -19,8 +19,10 @@ result):
   attributes agree perfectly (``K = 0``).  Every measure is non-decreasing in
   ``m^p(M)`` and in ``1 - K``, so a pair outside the position gate can never be
   matched, whatever its attributes, and pairs inside compete on pi.  Default
-  ``alpha = 0.01``, the usual 99 % gate.  ``tau = 0`` gives the plain rectangular
-  assignment (as many pairs as the smaller sensor has observations).
+  ``alpha = 0.01``, the usual 99 % gate.  ``tau = 0`` is the plain rectangular
+  assignment: no non-assignment option at all, exactly ``min(N1, N2)`` pairs (not a
+  miss cost of 0, which would tie with a pair of ``pi = 0`` and leave the answer to
+  the back end's tie rule), so every exact back end gives the same decisions.
 
 The model goes through :func:`assocopt.solve`, so any installed back end solves it.
 
@@ -94,13 +96,18 @@ def md_2da_problem(pi: ArrayLike, sensor: ArrayLike, tau: float,
     if (cross < 0).any():
         raise ValueError("pi must be >= 0 between the two sensors")
     if cost == "linear":
-        C, miss = -cross, -0.5 * tau
+        C = -cross
     else:
         with np.errstate(divide="ignore"):
             C = -np.log(cross)                      # pi = 0: +inf, a forbidden pair
-        miss = -0.5 * math.log(tau) if tau > 0 else math.inf
-    problem = AssignmentProblem.two_d(C, row_miss=miss if math.isfinite(miss) else None,
-                                      col_miss=miss if math.isfinite(miss) else None,
+    if tau == 0:
+        # the rectangular assignment: min(N1, N2) pairs and no non-assignment option.
+        # (A miss cost of -tau/2 = 0 would tie with pairing at pi = 0, and each back
+        # end would break the tie its own way.)
+        miss = None
+    else:
+        miss = -0.5 * tau if cost == "linear" else -0.5 * math.log(tau)
+    problem = AssignmentProblem.two_d(C, row_miss=miss, col_miss=miss,
                                       name="zhang2009-md2da")
     return problem, rows, cols
 
@@ -109,10 +116,8 @@ def md_2da(pi: ArrayLike, sensor: ArrayLike, *, tau: float, cost: str = "linear"
            solver: str = "auto", **solve_options: Any) -> MD2DAResult:
     """Decide the relations by 2-D assignment on ``pi`` (see the module docstring).
 
-    ``tau = 0`` with the linear cost is the rectangular assignment without
-    non-assignment: ``min(N1, N2)`` pairs (with ``cost="log"`` it forbids
-    non-assignment altogether, which is feasible only when N1 = N2 or via the
-    rectangular form, used then).
+    ``tau = 0`` (either cost) is the rectangular assignment without non-assignment:
+    ``min(N1, N2)`` pairs.
 
     Raises
     ------
