@@ -8,6 +8,9 @@ on dense matrices, :mod:`.murty2d`: Murty's method on it, imported by
 costs half a second). :mod:`assocopt.solvers.bnb.kernels` is the import point of the
 ``bnb`` kernels.
 
+Every kernel is decorated by :func:`.jit.njit` (numba's, with the disk cache placed so
+that a read-only install never fails: see :mod:`.jit`).
+
 numba's disk cache does not notice a change in a kernel another file calls: after
 editing ``sap.py``, delete ``__pycache__/murty2d.*.nb[ic]`` (the same holds for
 ``driver.py`` and the kernels it calls).

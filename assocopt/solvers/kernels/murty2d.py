@@ -43,7 +43,7 @@ from __future__ import annotations
 import heapq
 
 import numpy as np
-from numba import njit
+from .jit import njit
 
 from .sap import augment, lap_warm, row_start
 

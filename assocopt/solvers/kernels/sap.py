@@ -34,7 +34,7 @@ the conditions above, for the next child.
 from __future__ import annotations
 
 import numpy as np
-from numba import njit
+from .jit import njit
 
 INF = np.inf
 
