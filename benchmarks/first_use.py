@@ -22,7 +22,6 @@ from __future__ import annotations
 
 import argparse
 import json
-import math
 import os
 import platform
 import shutil
@@ -185,17 +184,177 @@ def run_one(key: str, small: bool = False) -> dict[str, Any]:
             "compile_s": c1[0] - c0[0], "cache_load_s": c1[1] - c0[1]}
 
 
+#: Paths the test of NUMBA_DISABLE_JIT runs but the benchmark does not time (the
+#: same kernels as another row: ``auto`` on that problem is ``bnb``).
+NOT_TIMED = {"auto"}
+
+
+def _load() -> list[float]:
+    return [round(v, 2) for v in os.getloadavg()]
+
+
+def _fresh(keys: list[str], cache: str) -> dict[str, Any]:
+    """Run ``keys`` in a fresh interpreter with ``NUMBA_CACHE_DIR=cache``: the rows of
+    :func:`run_one` and the process's own wall time (spawn to exit)."""
+    env = {k: v for k, v in os.environ.items() if not k.startswith("NUMBA_")}
+    env.update(NUMBA_CACHE_DIR=cache, PYTHONPATH=str(ROOT))
+    t0 = time.perf_counter()
+    done = subprocess.run([sys.executable, str(Path(__file__).resolve()), "--one", *keys],
+                          env=env, cwd=ROOT, capture_output=True, text=True)
+    wall = time.perf_counter() - t0
+    if done.returncode != 0:
+        raise RuntimeError(f"{keys} exited {done.returncode}: {done.stderr[-1500:]}")
+    notes = [ln for ln in done.stderr.splitlines() if "compiling numba kernels" in ln]
+    return {"rows": json.loads(done.stdout.splitlines()[-1]), "process_s": wall,
+            "notes": len(notes)}
+
+
+def _row(r: dict[str, Any]) -> dict[str, Any]:
+    return {k: round(r[k], 4) for k in ("wall_s", "cpu_s", "compile_s", "cache_load_s")}
+
+
+def measure(keys: list[str]) -> dict[str, Any]:
+    """Cold and warm first calls of each path, then all of them in one cold process."""
+    load_before = _load()
+    rows = []
+    for key in keys:
+        cache = tempfile.mkdtemp(prefix="assocopt-first-use-")
+        try:
+            cold = _fresh([key], cache)
+            warm = _fresh([key], cache)
+        finally:
+            shutil.rmtree(cache, ignore_errors=True)
+        what = {k: w for k, w, _ in PATHS}[key]
+        row = {"key": key, "what": what, "cold": _row(cold["rows"][0]),
+               "warm": _row(warm["rows"][0]), "cold_process_s": round(cold["process_s"], 3),
+               "warm_process_s": round(warm["process_s"], 3),
+               "cold_notes": cold["notes"], "warm_notes": warm["notes"],
+               "load": _load()}
+        rows.append(row)
+        print(f"{key:<17} cold {row['cold']['wall_s']:7.2f} s (CPU {row['cold']['cpu_s']:.2f}, "
+              f"compile {row['cold']['compile_s']:.2f})  warm {row['warm']['wall_s']:.3f} s "
+              f"(load {row['warm']['cache_load_s']:.3f})  load avg {row['load']}", flush=True)
+    cache = tempfile.mkdtemp(prefix="assocopt-first-use-")
+    try:
+        together = _fresh(keys, cache)
+    finally:
+        shutil.rmtree(cache, ignore_errors=True)
+    all_rows = together["rows"]
+    total = {"wall_s": round(sum(r["wall_s"] for r in all_rows), 3),
+             "cpu_s": round(sum(r["cpu_s"] for r in all_rows), 3),
+             "compile_s": round(sum(r["compile_s"] for r in all_rows), 3),
+             "process_s": round(together["process_s"], 3), "notes": together["notes"],
+             "per_path": {r["key"]: _row(r) for r in all_rows}}
+    print(f"all together: {total['wall_s']:.2f} s (CPU {total['cpu_s']:.2f})", flush=True)
+    return {"targets": {"cold_s": COLD_TARGET, "all_s": ALL_TARGET, "warm_s": WARM_TARGET},
+            "machine": {"python": platform.python_version(), "system": platform.system(),
+                        "machine": platform.machine(), "cpus": os.cpu_count()},
+            "versions": _versions(), "load_before": load_before, "load_after": _load(),
+            "rows": rows, "together": total}
+
+
+def _versions() -> dict[str, str]:
+    import importlib.metadata as md
+    out = {}
+    for dist in ("numpy", "scipy", "numba", "llvmlite"):
+        try:
+            out[dist] = md.version(dist)
+        except md.PackageNotFoundError:
+            out[dist] = "-"
+    return out
+
+
+def _met(value: float, target: float) -> str:
+    return "yes" if value <= target else "no"
+
+
+def render(data: dict[str, Any]) -> str:
+    """The docs page for the measurements ``data`` (tests/test_benchmarks_first_use.py
+    checks that the committed page is this function of the committed json)."""
+    m, v, t = data["machine"], data["versions"], data["targets"]
+    lines = [
+        "# First use: compiling the kernels",
+        "",
+        "Measured by `python benchmarks/first_use.py` (numbers below from "
+        "`docs/benchmarks-first-use.json`, written by the same run). Each path is one "
+        "public call in a fresh interpreter. *Cold*: `NUMBA_CACHE_DIR` is an empty "
+        "folder, so numba compiles every kernel the call needs; *warm*: a second fresh "
+        "interpreter with that folder filled, so the kernels are loaded from disk. "
+        "Times are of the call alone (wall and CPU of the process from before the call "
+        "to after it; the interpreter's start and `import assocopt` are not in them); "
+        "*compile* and *cache load* are the parts of it that "
+        "`assocopt.solvers.kernels.ensure` timed. *Note* says whether the call said, "
+        "before compiling, that it would (one log line of the `assocopt` logger).",
+        "",
+        f"Machine: Python {m['python']}, {m['system']} {m['machine']}, {m['cpus']} CPUs; "
+        f"numpy {v['numpy']}, scipy {v['scipy']}, numba {v['numba']}, llvmlite "
+        f"{v['llvmlite']}. Load average (1, 5, 15 min) before the run "
+        f"{', '.join(f'{x:g}' for x in data['load_before'])}, after it "
+        f"{', '.join(f'{x:g}' for x in data['load_after'])}: on a loaded machine the "
+        "wall times stretch, the CPU times much less.",
+        "",
+        f"Targets: a cold first call at most {t['cold_s']:g} s, all paths in one cold "
+        f"process at most {t['all_s']:g} s, a warm (cached) first call at most "
+        f"{t['warm_s']:g} s; judged here on CPU time.",
+        "",
+        "| path | cold (s) | cold CPU (s) | compile (s) | note | met | warm (s) | "
+        "cache load (s) | met | load avg |",
+        "|---|---|---|---|---|---|---|---|---|---|",
+    ]
+    for r in data["rows"]:
+        c, w = r["cold"], r["warm"]
+        lines.append(
+            f"| {r['what']} | {c['wall_s']:.2f} | {c['cpu_s']:.2f} | {c['compile_s']:.2f} | "
+            f"{'yes' if r['cold_notes'] else 'no'} | {_met(c['cpu_s'], t['cold_s'])} | "
+            f"{w['wall_s']:.3f} | {w['cache_load_s']:.3f} | "
+            f"{_met(w['cpu_s'], t['warm_s'])} | {r['load'][0]:g} |")
+    tg = data["together"]
+    lines += [
+        "",
+        f"All paths in one cold process, in the order above: {tg['wall_s']:.2f} s "
+        f"({tg['cpu_s']:.2f} s CPU, of it {tg['compile_s']:.2f} s compiling; kernels "
+        "two paths share are compiled once); target met: "
+        f"{_met(tg['cpu_s'], t['all_s'])}. The process as a whole, interpreter start and "
+        f"imports included, took {tg['process_s']:.2f} s.",
+        "",
+        "Where the compile time goes (numba's `numba:compile` events per function and "
+        "signature, measured while cutting it): typing and lowering in numba's Python "
+        "code and LLVM's optimisation of each kernel together with every kernel it "
+        "calls; numba's own library functions (`np.argsort`, array slice assignment with "
+        "its broadcasting checks, `heapq`) are compiled anew for each signature they "
+        "meet. Cut so far: duplicate specialisations (a literal `-1` argument compiled "
+        "`augment` twice; growing arrays by slice assignment compiled numba's "
+        "broadcasting code for each dtype). A read-only install caches in the user's "
+        "cache or, failing that, in a temporary folder of the process, which then "
+        "compiles cold in every new process.",
+        "",
+    ]
+    return "\n".join(lines)
+
+
 def main(argv: list[str] | None = None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     ap.add_argument("--one", nargs="+", help="run these paths in this process (JSON)")
     ap.add_argument("--small", action="store_true", help="with --one: small problems")
+    ap.add_argument("--paths", nargs="+", help="the paths to time (default: all)")
+    ap.add_argument("--render", action="store_true",
+                    help="write the page from the committed JSON only")
     ap.add_argument("--no-write", action="store_true", help="print only")
     args = ap.parse_args(argv)
     if args.one:
         out = [run_one(k, args.small) for k in args.one]
         print(json.dumps(out))
         return 0
-    raise SystemExit("measurement not written yet")
+    if args.render:
+        PAGE.write_text(render(json.loads(DATA.read_text())))
+        return 0
+    keys = args.paths or [k for k, _, _ in PATHS if k not in NOT_TIMED]
+    data = measure(keys)
+    if not args.no_write:
+        DATA.write_text(json.dumps(data, indent=2) + "\n")
+        PAGE.write_text(render(data))
+        print(f"wrote {PAGE.relative_to(ROOT)} and {DATA.relative_to(ROOT)}")
+    return 0
 
 
 if __name__ == "__main__":
