@@ -301,8 +301,9 @@ def render(data: dict[str, Any]) -> str:
         "Times are of the call alone (wall and CPU of the process from before the call "
         "to after it; the interpreter's start, `import assocopt` and building the problem "
         "are not in them); "
-        "*compile* and *cache load* are the parts of it that "
-        "`assocopt.solvers.kernels.ensure` timed. *Note* says whether the call said, "
+        "*compiling* and *cache load* are the parts of it (wall time) that "
+        "`assocopt.solvers.kernels.ensure` timed; a warm call also imports numba "
+        "(the first kernel a process uses imports it). *Note* says whether the call said, "
         "before compiling, that it would (one log line of the `assocopt` logger).",
         "",
         f"Machine: Python {m['python']}, {m['system']} {m['machine']}, {m['cpus']} CPUs; "
@@ -316,7 +317,7 @@ def render(data: dict[str, Any]) -> str:
         f"process at most {t['all_s']:g} s, a warm (cached) first call at most "
         f"{t['warm_s']:g} s; judged here on CPU time.",
         "",
-        "| path | cold (s) | cold CPU (s) | compile (s) | note | met | warm (s) | "
+        "| path | cold (s) | cold CPU (s) | compiling (s) | note | met | warm (s) | "
         "cache load (s) | met | load avg |",
         "|---|---|---|---|---|---|---|---|---|---|",
     ]
@@ -331,8 +332,8 @@ def render(data: dict[str, Any]) -> str:
     lines += [
         "",
         f"All paths in one cold process, in the order above: {tg['wall_s']:.2f} s "
-        f"({tg['cpu_s']:.2f} s CPU, of it {tg['compile_s']:.2f} s compiling; kernels "
-        "two paths share are compiled once); target met: "
+        f"({tg['cpu_s']:.2f} s CPU; {tg['compile_s']:.2f} s of the wall time compiling; "
+        "kernels two paths share are compiled once); target met: "
         f"{_met(tg['cpu_s'], t['all_s'])}. The process as a whole, interpreter start and "
         f"imports included, took {tg['process_s']:.2f} s.",
         "",
@@ -345,7 +346,8 @@ def render(data: dict[str, Any]) -> str:
         "`augment` twice; growing arrays by slice assignment compiled numba's "
         "broadcasting code for each dtype). A read-only install caches in the user's "
         "cache or, failing that, in a temporary folder of the process, which then "
-        "compiles cold in every new process.",
+        "compiles cold in every new process. `NUMBA_DISABLE_JIT=1` runs every kernel as "
+        "plain Python with the same answers (tests/test_disable_jit.py).",
         "",
     ]
     return "\n".join(lines)
