@@ -78,6 +78,7 @@ def _compile_note(problem: Any, solver: str, relax: str | None, err: TextIO) -> 
         return False
     print("assocopt: compiling the numba kernels (first run only, about 15-30 s; "
           "cached afterwards) ...", end="", file=err, flush=True)
+    _kernel_note_given()
     return True
 
 
@@ -93,7 +94,15 @@ def _kbest_note(problem: Any, solver: str, err: TextIO) -> bool:
         return False
     print("assocopt: compiling the numba kernels (first run only, about 15-30 s; "
           "cached afterwards) ...", end="", file=err, flush=True)
+    _kernel_note_given()
     return True
+
+
+def _kernel_note_given() -> None:
+    """Tell the kernels that this note is given (the API would say it again)."""
+    from ..solvers.kernels import announced
+
+    announced(now=True)
 
 
 def _compile_done(sol: Any, begun: bool, err: TextIO) -> None:

@@ -132,8 +132,8 @@ def kbest_2d(problem: AssignmentProblem, k: int) -> tuple[list[Solution], bool, 
     tol = 1e-9 * max(1.0, float(finite.max()) if finite.size else 1.0)
     k = min(k, 2**62)              # the kernel counts in int64
     k0 = spent()
-    if not murty.overloads:        # the one signature (float64 matrix): once a process
-        ensure(murty, form.A, form.P, k, tol)
+    if not getattr(murty, "overloads", True):   # the one signature, once a process
+        ensure(murty, form.A, form.P, k, tol)     # (NUMBA_DISABLE_JIT: a plain function)
     k1 = spent()
     X, _, n, exhausted, solved = murty(form.A, form.P, k, tol)
     X = np.where(X < form.n_real_cols, X, -1)

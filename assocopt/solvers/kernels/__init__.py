@@ -9,6 +9,9 @@ on dense matrices, :mod:`.murty2d`: Murty's method on it, imported by
 costs half a second). :mod:`assocopt.solvers.bnb.kernels` is the import point of the
 ``bnb`` kernels.
 
+Every kernel is decorated by :func:`.jit.njit` (numba's, with the disk cache placed so
+that a read-only install never fails: see :mod:`.jit`).
+
 numba's disk cache does not notice a change in a kernel another file calls: after
 editing ``sap.py``, delete ``__pycache__/murty2d.*.nb[ic]`` (the same holds for
 ``driver.py`` and the kernels it calls).
@@ -23,10 +26,24 @@ May import: nothing of assocopt (numba and numpy only): every part of
 
 from __future__ import annotations
 
+import logging
 import time
 from typing import Any
 
-__all__ = ["ensure", "spent"]
+__all__ = ["ensure", "spent", "announced"]
+
+_LOG = logging.getLogger("assocopt")
+
+#: Whether this process has said that kernels are being compiled (once a process).
+_ANNOUNCED = [False]
+
+
+def announced(now: bool = False) -> bool:
+    """Whether the compile note of this process has been given; ``now=True`` records
+    that the caller gives it itself (the command line prints its own)."""
+    if now:
+        _ANNOUNCED[0] = True
+    return _ANNOUNCED[0]
 
 
 #: Seconds this process spent compiling kernels and loading them from numba's disk
@@ -61,12 +78,30 @@ def ensure(kernel: Any, *args: Any) -> None:
     if sig in kernel.overloads:
         _SEEN.add(key)
         return
+    if not _ANNOUNCED[0] and not _on_disk(kernel, sig):
+        _ANNOUNCED[0] = True
+        _LOG.warning("assocopt: compiling numba kernels for %s (first use with an empty "
+                     "cache: seconds; cached on disk afterwards)", kernel.__name__)
     hits = sum(kernel.stats.cache_hits.values())
     t0 = time.perf_counter()
     kernel.compile(sig)
     dt = time.perf_counter() - t0
     _SPENT["cache_load" if sum(kernel.stats.cache_hits.values()) > hits else "compile"] += dt
     _SEEN.add(key)
+
+
+def _on_disk(kernel: Any, sig: tuple) -> bool:
+    """Whether numba's disk cache holds ``kernel`` for ``sig`` (its index read as
+    numba's own ``load_overload`` does: not public API, so any surprise answers True,
+    no note rather than a wrong one).  A kernel without a disk cache answers False."""
+    try:
+        cache = kernel._cache
+        if not hasattr(cache, "_cache_file"):          # NullCache: compiled every time
+            return False
+        key = cache._index_key(sig, kernel.targetctx.codegen())
+        return key in cache._cache_file._load_index()
+    except Exception:
+        return True
 
 
 #: Cheap keys of the signatures :func:`ensure` has seen compiled.

@@ -11,7 +11,7 @@ then the driver's ascent and search, with the two largest axes kept.
 from __future__ import annotations
 
 import numpy as np
-from numba import njit
+from .jit import njit
 
 from .driver import PROVEN, STOPPED, solve
 from .relaxation import prepare

@@ -10,7 +10,7 @@ of a gated N = 5 tracking scan (12,326 candidates): 63 ms in numpy, a few ms her
 from __future__ import annotations
 
 import numpy as np
-from numba import njit
+from .jit import njit
 
 __all__ = ["dominated_kernel"]
 

@@ -4,7 +4,7 @@ searches, then the final search; one compiled call per problem."""
 from __future__ import annotations
 
 import numpy as np
-from numba import njit
+from .jit import njit
 
 from .hungarian import hungarian
 from .recovery import recover3_sparse

@@ -4,7 +4,7 @@ augmenting paths), cold or warm-started; compiled with numba."""
 from __future__ import annotations
 
 import numpy as np
-from numba import njit
+from .jit import njit
 
 INF = np.inf
 

@@ -43,7 +43,7 @@ from __future__ import annotations
 import heapq
 
 import numpy as np
-from numba import njit
+from .jit import njit
 
 from .sap import augment, lap_warm, row_start
 
@@ -52,17 +52,22 @@ INF = np.inf
 
 @njit(cache=True)
 def _grow(a, cap):
-    """The 1-D ``a`` copied into an array of length ``cap``."""
+    """The 1-D ``a`` copied into an array of length ``cap`` (a plain loop: slice
+    assignment brings numba's broadcasting machinery, seconds of compilation)."""
     b = np.empty(cap, a.dtype)
-    b[:a.shape[0]] = a
+    for i in range(a.shape[0]):
+        b[i] = a[i]
     return b
 
 
 @njit(cache=True)
 def _grow2(a, cap):
-    """The 2-D ``a`` (rows = slots) copied into an array of ``cap`` rows."""
+    """The 2-D ``a`` (rows = slots) copied into an array of ``cap`` rows (a loop,
+    as in :func:`_grow`)."""
     b = np.empty((cap, a.shape[1]), a.dtype)
-    b[:a.shape[0]] = a
+    for i in range(a.shape[0]):
+        for j in range(a.shape[1]):
+            b[i, j] = a[i, j]
     return b
 
 

@@ -15,7 +15,7 @@ compiled sparse LAP (:mod:`.sparse_lap`) solves it in microseconds.
 from __future__ import annotations
 
 import numpy as np
-from numba import njit
+from .jit import njit
 
 from .sparse_lap import lap_edges
 

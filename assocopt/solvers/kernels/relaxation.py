@@ -5,7 +5,7 @@ dual raising and reduced-cost fixing of the candidate lists."""
 from __future__ import annotations
 
 import numpy as np
-from numba import njit
+from .jit import njit
 
 from .hungarian import hungarian_warm
 

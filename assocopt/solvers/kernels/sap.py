@@ -34,7 +34,7 @@ the conditions above, for the next child.
 from __future__ import annotations
 
 import numpy as np
-from numba import njit
+from .jit import njit
 
 INF = np.inf
 
@@ -163,9 +163,10 @@ def lap_warm(A, x, y, u, v):
     pred = np.empty(nc, np.int64)
     done = np.zeros(nc, np.bool_)
     scanned = np.empty(nc, np.int64)
+    free = np.int64(-1)     # not the literal -1: one specialisation of augment, not two
     for i in range(nr):
         if x[i] < 0:
-            if augment(A, i, -1, x, y, u, v, cols, nc, d, pred, done, scanned) == INF:
+            if augment(A, i, free, x, y, u, v, cols, nc, d, pred, done, scanned) == INF:
                 return False
     return True
 

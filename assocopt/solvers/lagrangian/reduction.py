@@ -110,4 +110,5 @@ def _dominated_compiled(sizes: tuple[int, ...], T: np.ndarray, c: np.ndarray,
     args = (np.ascontiguousarray(T, np.int64), np.ascontiguousarray(c, np.float64), off,
             radix, single_cost, fits)
     ensure(dominated_kernel, *args)
-    return dominated_kernel(*args)
+    with np.errstate(over="ignore"):     # the hash wraps (NUMBA_DISABLE_JIT: numpy warns)
+        return dominated_kernel(*args)

@@ -7,9 +7,9 @@ same computation through :func:`assocopt.solve`, one pair at a time (the check).
 from __future__ import annotations
 
 import numpy as np
-from numba import njit
 
 from ...solvers.kernels.hungarian import hungarian
+from ...solvers.kernels.jit import njit
 
 INF = np.inf
 

@@ -68,8 +68,9 @@ from dataclasses import dataclass, asdict
 from typing import Any
 
 import numpy as np
-from numba import njit
 from numpy.typing import ArrayLike
+
+from ...solvers.kernels.jit import njit
 
 __all__ = ["DIDParams", "DIDResult", "ERRORS", "SELECTS", "UNRESOLVED", "relative_errors",
            "SCORES", "initial_states", "dominance", "stage1_case", "stage2", "did_decide",
