@@ -26,7 +26,7 @@ does not see a change in a kernel another file calls).
 from __future__ import annotations
 
 import numpy as np
-from numba import njit
+from .jit import njit
 
 from .ehm_net import hypothesis_net
 

@@ -19,7 +19,7 @@ May import nothing of assocopt (see :mod:`assocopt.solvers.kernels`).
 from __future__ import annotations
 
 import numpy as np
-from numba import njit
+from .jit import njit
 
 __all__ = ["hypothesis_net"]
 
