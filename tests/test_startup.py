@@ -98,7 +98,7 @@ def test_one_shot_highs_answer_equals_auto_in_the_library(capsys):
     from assocopt import solve
     from assocopt.cli import main
     from assocopt.io import read_instance
-    import assocopt.cli.solve_cmds as sc
+    import assocopt.cli.one_shot as sc
 
     if importlib.util.find_spec("highspy") is None:
         pytest.skip("needs highspy")
@@ -152,7 +152,7 @@ def test_one_shot_answer_equals_auto_in_the_library(capsys):
 
 def test_one_shot_falls_back_when_enumeration_is_too_long(capsys, monkeypatch):
     """A search that runs out of nodes goes to auto's back end as before."""
-    import assocopt.cli.solve_cmds as sc
+    import assocopt.cli.one_shot as sc
     from assocopt.cli import main
 
     monkeypatch.setattr(sc, "ONE_SHOT_NODES", 3)

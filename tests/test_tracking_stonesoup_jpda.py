@@ -28,10 +28,6 @@ from assocopt.tracking.stonesoup import jpda as jpda_mod  # noqa: E402
 from assocopt.tracking.stonesoup.problems import hypothesis_table  # noqa: E402
 from assocopt.tracking.stonesoup.scenario import entangled_scan  # noqa: E402
 
-#: Both engines where the exact one is installed; the cluster sums alone otherwise.
-ENGINES = [None] + ([jpda_mod.EXACT_METHOD] if jpda_mod.EXACT_METHOD else [])
-
-
 class Cached(Hypothesiser):
     """Serves fixed hypotheses, so that both associators get the very same objects."""
 
@@ -163,8 +159,7 @@ def test_bad_hypotheses_are_clear_errors():
 
 # --------------------------------------------------------------------------- JPDA
 @pytest.mark.parametrize("seed", range(6))
-@pytest.mark.parametrize("engine", ENGINES)
-def test_probabilities_equal_jpda_with_ehm2_on_entangled_scenes(seed, engine):
+def test_probabilities_equal_jpda_with_ehm2_on_entangled_scenes(seed):
     rng = np.random.default_rng(100 + seed)
     size = 1 + seed % 5                                 # 1 .. 5 tracks per cluster
     scan = entangled_scan(rng, n_clusters=3, cluster_size=size,
@@ -174,7 +169,7 @@ def test_probabilities_equal_jpda_with_ehm2_on_entangled_scenes(seed, engine):
     cached.table = _hypotheses(scan)
     ref = JPDAwithEHM2(cached).associate(set(scan.tracks), scan.detections, scan.timestamp)
     pp = probability_problem(cached.table)
-    P = jpda_mod.association_probabilities(pp, engine)
+    P = jpda_mod.association_probabilities(pp)
     _same_posterior(pp.posterior(P), ref)
     ours = AssocoptJPDA(cached).associate(set(scan.tracks), scan.detections, scan.timestamp)
     _same_posterior(ours, ref)
@@ -242,18 +237,12 @@ def test_a_track_without_hypotheses_gets_an_empty_one():
     assert len(out[extra]) == 0 and set(out) == set(hyps)
 
 
-def test_without_the_exact_engine_a_huge_cluster_is_an_error_naming_its_size(monkeypatch):
+def test_a_cluster_over_the_budget_is_an_error_naming_its_size():
     scan = entangled_scan(np.random.default_rng(10), n_clusters=1, cluster_size=4,
                           spacing=1.0)
     pp = probability_problem(_hypotheses(scan))
-    monkeypatch.setattr(jpda_mod, "MAX_JOINT", 4)
-    with pytest.raises(assocopt.ProblemTooLargeError, match="cluster of 4 tracks"):
-        jpda_mod.association_probabilities(pp, None)
-
-
-def test_the_exact_engine_is_used_when_marginals_offers_it():
-    from assocopt.ranking import marginals as mod
-    assert jpda_mod.EXACT_METHOD == ("exact" if "exact" in mod.METHODS else None)
+    with pytest.raises(assocopt.ProblemTooLargeError, match="cluster of"):
+        jpda_mod.association_probabilities(pp, max_nodes=2)
 
 
 @pytest.mark.parametrize("seed", [0, 1])
@@ -314,9 +303,9 @@ def test_same_tracks_as_jpda_with_ehm2_in_the_mixture_tracker(seed):
 
 
 @pytest.mark.parametrize("dense", [True, False])
-def test_the_whole_scan_path_maps_the_marginals_back(monkeypatch, dense):
-    """The path taken when marginals has method="exact" (one call on the whole scan),
-    run here with an exhaustive ranking standing in for it where it is not installed."""
+def test_the_whole_scan_is_one_exact_marginals_call(monkeypatch, dense):
+    """One ``marginals(method="exact")`` call on the whole scan (it splits the clusters),
+    dense or sparse problem, mapped back to the hypotheses as EHM2 gives them."""
     scan = entangled_scan(np.random.default_rng(11), n_clusters=2, cluster_size=3)
     cached = Cached()
     cached.table = _hypotheses(scan)
@@ -324,15 +313,11 @@ def test_the_whole_scan_path_maps_the_marginals_back(monkeypatch, dense):
     pp = probability_problem(cached.table, dense=dense)
     calls = []
 
-    def stand_in(problem, method):
+    def spy(problem, method, **kw):
         calls.append(method)
-        if method == jpda_mod.EXACT_METHOD:
-            return assocopt.marginals(problem, method=method)
-        m = assocopt.marginals(problem, k=10**5, method="kbest")
-        assert m.exhaustive
-        return m
+        return assocopt.marginals(problem, method=method, **kw)
 
-    monkeypatch.setattr(jpda_mod, "marginals", stand_in)
-    P = jpda_mod.association_probabilities(pp, "exact")
+    monkeypatch.setattr(jpda_mod, "marginals", spy)
+    P = jpda_mod.association_probabilities(pp)
     assert calls == ["exact"]
     _same_posterior(pp.posterior(P), ref)
