@@ -52,6 +52,7 @@ def site(tmp_path_factory) -> Path:
     work = tmp_path_factory.mktemp("site")
     src = work / "docs"
     shutil.copytree(DOCS, src, ignore=_sources_only)
+    shutil.copy(ROOT / "README.md", work / "README.md")     # docs/layout.md includes it
     out = work / "html"
     env = {k: v for k, v in os.environ.items() if k != "MPLBACKEND"}   # notebooks: inline
     env["PYTHONPATH"] = str(ROOT) + os.pathsep + os.environ.get("PYTHONPATH", "")
