@@ -61,6 +61,9 @@ def arm(exit_code: int) -> Callable[[], None]:
             fired.set()
             threading.Thread(target=leave_later, name="assocopt-watchdog",
                              daemon=True).start()
+        kernels = sys.modules.get("assocopt.solvers.kernels")   # not imported: not busy
+        if kernels is not None and kernels.defer_interrupt():
+            return                     # inside numba's compiler: raised when it is done
         raise KeyboardInterrupt
 
     old_hook = sys.unraisablehook

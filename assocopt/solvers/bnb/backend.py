@@ -139,7 +139,8 @@ class BnbInput:
         args = (problem.tuples, problem.row_offsets, np.asarray(problem.sizes, np.int64),
                 c, a, b)
         kern.ensure(kern.prepare, *args)
-        G, ptr, lst, y0, axis_of, int_costs, plain = kern.prepare(*args)
+        with kern.uninterrupted():      # a Ctrl-C inside numba's call crashed the process
+            G, ptr, lst, y0, axis_of, int_costs, plain = kern.prepare(*args)
         return cls(G=G, c=c, a=a, b=b, relaxed=relaxed, off=problem.row_offsets,
                    plain=bool(plain), axis_of=axis_of, ptr=ptr, lst=lst,
                    int_costs=bool(int_costs), y0=y0)

@@ -19,7 +19,7 @@ the ascent only makes it tight.
 
 from typing import Any
 
-from ..kernels import ensure, spent  # noqa: F401  (compile / cache-load clock)
+from ..kernels import ensure, spent, uninterrupted  # noqa: F401  (compile clock; Ctrl-C)
 from ..kernels.driver import (INFEASIBLE, PROVEN, STOPPED, recover3, solve,  # noqa: F401
                              tuple_index)
 from ..kernels.hungarian import hungarian, hungarian_warm  # noqa: F401

@@ -26,16 +26,53 @@ May import: nothing of assocopt (numba and numpy only): every part of
 
 from __future__ import annotations
 
+import contextlib
 import logging
 import time
-from typing import Any
+from typing import Any, Iterator
 
-__all__ = ["ensure", "spent", "announced"]
+__all__ = ["ensure", "spent", "announced", "defer_interrupt",
+           "uninterrupted"]
 
 _LOG = logging.getLogger("assocopt")
 
 #: Whether this process has said that kernels are being compiled (once a process).
 _ANNOUNCED = [False]
+
+
+#: Compiles or cache loads in progress (:func:`ensure`), and whether a Ctrl-C arrived
+#: during one.  A ``KeyboardInterrupt`` raised inside numba's LLVM code is lost in a
+#: callback there and can leave a half-loaded kernel that crashes when called, so a
+#: SIGINT handler asks :func:`defer_interrupt` first, and the interrupt is raised
+#: when the compile is done (:func:`uninterrupted`).  A kernel called in the main thread
+#: is such a section too: a ``KeyboardInterrupt`` raised while numba unboxes its
+#: arguments or boxes its results crashed the process (SIGSEGV, seen about once in 15
+#: Ctrl-C's during ``bnb``'s set-up).
+_BUSY = [0]
+_DEFERRED = [False]
+
+
+def defer_interrupt() -> bool:
+    """Whether a kernel is being compiled or loaded now; if so, the interrupt is raised
+    as ``KeyboardInterrupt`` when that is done (for a SIGINT handler)."""
+    if _BUSY[0] > 0:
+        _DEFERRED[0] = True
+        return True
+    return False
+
+
+@contextlib.contextmanager
+def uninterrupted() -> Iterator[None]:
+    """A section (a compile, a kernel call in the main thread) in which a Ctrl-C is
+    held back by :func:`defer_interrupt` and raised when the section ends."""
+    _BUSY[0] += 1
+    try:
+        yield
+    finally:
+        _BUSY[0] -= 1
+    if _BUSY[0] == 0 and _DEFERRED[0]:
+        _DEFERRED[0] = False
+        raise KeyboardInterrupt
 
 
 def announced(now: bool = False) -> bool:
@@ -84,7 +121,8 @@ def ensure(kernel: Any, *args: Any) -> None:
                      "cache: seconds; cached on disk afterwards)", kernel.__name__)
     hits = sum(kernel.stats.cache_hits.values())
     t0 = time.perf_counter()
-    kernel.compile(sig)
+    with uninterrupted():
+        kernel.compile(sig)
     dt = time.perf_counter() - t0
     _SPENT["cache_load" if sum(kernel.stats.cache_hits.values()) > hits else "compile"] += dt
     _SEEN.add(key)
