@@ -133,10 +133,17 @@ def marginals(problem: AssignmentProblem, k: int = 100, temperature: float = 1.0
     if method in ("exact", "auto"):
         return _exact(problem, logw, k, T, solver, method, max_nodes)
     P = np.zeros(problem.n_candidates)
-    log_z = 0.0
-    hyps = approx = 0
-    bound = 0.0
     parts = _clusters(problem)
+    log_z, hyps, approx, bound = _sum_ranked(problem, parts, k, T, solver, method, P)
+    return _result(problem, P, hyps, bound == 0.0, T, log_z, method, bound, 0, 0.0,
+                   len(parts), approx, 0)
+
+
+def _sum_ranked(problem: AssignmentProblem, parts: list, k: int, T: float, solver: str,
+                method: str, P: np.ndarray) -> tuple[float, int, int, float]:
+    """The k-best sums of the clusters ``parts``, written into ``P``; returns their
+    log-partition, hypotheses summed, clusters approximated and largest error bound."""
+    log_z, hyps, approx, bound = 0.0, 0, 0, 0.0
     for cl in parts:
         lz, p, h, b = _ranked(problem, cl, k, T, solver, method)
         if not lz > -math.inf:
@@ -146,8 +153,7 @@ def marginals(problem: AssignmentProblem, k: int = 100, temperature: float = 1.0
         log_z += lz
         hyps += h
         bound = max(bound, b)
-    return _result(problem, P, hyps, bound == 0.0, T, log_z, method, bound, 0, 0.0,
-                   len(parts), approx, 0)
+    return log_z, hyps, approx, bound
 
 
 def _exact(problem: AssignmentProblem, logw: np.ndarray, k: int, T: float, solver: str,
@@ -161,22 +167,14 @@ def _exact(problem: AssignmentProblem, logw: np.ndarray, k: int, T: float, solve
     if (ex.status == 2).any():
         raise InvalidProblemError("the problem has no feasible solution: no marginals")
     P = ex.P
-    log_z = float(ex.log_z[ex.status == 0].sum())
-    hyps = approx = 0
-    bound = 0.0
-    for c in np.flatnonzero(ex.status != 0):
-        cl = ex.cluster(int(c))
-        if method == "exact":
-            raise ProblemTooLargeError(too_large(problem, cl, int(ex.status[c]),
-                                                 int(ex.width[c]), max_nodes))
-        lz, p, h, b = _ranked(problem, cl, k, T, solver, "kbest")
-        if not lz > -math.inf:
-            raise InvalidProblemError("the problem has no feasible solution: no marginals")
-        approx += b > 0
-        P[cl.candidates] = p
-        log_z += lz
-        hyps += h
-        bound = max(bound, b)
+    left = np.flatnonzero(ex.status != 0)
+    if method == "exact" and len(left):
+        c = int(left[0])
+        raise ProblemTooLargeError(too_large(problem, ex.cluster(c), int(ex.status[c]),
+                                             int(ex.width[c]), max_nodes))
+    lz, hyps, approx, bound = _sum_ranked(problem, [ex.cluster(int(c)) for c in left], k, T,
+                                          solver, "kbest", P)
+    log_z = float(ex.log_z[ex.status == 0].sum()) + lz
     if bound > WARN_BOUND:
         warnings.warn(f"marginals: {approx} of {len(ex.log_z)} clusters are too large for "
                       f"the exact net (max_nodes={max_nodes}); their k-best sums (k={k}) "
