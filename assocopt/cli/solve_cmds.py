@@ -29,17 +29,29 @@ def _compile_note(problem: Any, solver: str, relax: str | None, err: TextIO) -> 
     name = choose_solver(problem, relax) if solver == "auto" else solver
     if relax is not None or name != "bnb" or not get_backend("bnb").is_available():
         return False
+    if not _will_compile("driver.solve", problem.n_candidates):
+        return False
     from ..solvers.bnb import kernels as bnb_kernels
     if bnb_kernels.cached():
         return False
     return _say_compiling(err)
 
 
-def _kbest_note(problem: Any, solver: str, err: TextIO) -> bool:
+def _will_compile(kernel: str, work: float) -> bool:
+    """Whether the kernel would be compiled rather than run interpreted (a small
+    problem in a fresh process: :mod:`assocopt.solvers.kernels.tiers`)."""
+    from ..solvers.kernels import tiers
+    return not tiers.interpret(kernel, work, lambda: False)
+
+
+def _kbest_note(problem: Any, solver: str, err: TextIO, k: int = 1) -> bool:
     """:func:`_compile_note` for the compiled 2-D ranking of ``--kbest``."""
     from ..ranking import kbest2d
 
     if problem.ndim != 2 or solver not in ("auto", kbest2d.NAME) or not kbest2d.available():
+        return False
+    n1, n2 = problem.sizes
+    if not _will_compile("murty2d.murty", k * n1 * (n1 + n2)):
         return False
     from ..solvers.bnb import kernels as bnb_kernels
     from ..solvers.kernels.murty2d import murty
@@ -87,7 +99,8 @@ def _cmd_kbest(args: argparse.Namespace, out: TextIO, err: TextIO) -> int:
     problem = read_instance(_instance_path(args.file), format=args.format,
                             instance=args.instance)
     solver = args.solver or "auto"
-    begun = _compile_note(problem, solver, None, err) or _kbest_note(problem, solver, err)
+    begun = _compile_note(problem, solver, None, err) or \
+        _kbest_note(problem, solver, err, args.kbest)
     ranked = None
     try:
         ranked = kbest(problem, args.kbest, solver)

@@ -58,12 +58,11 @@ def exact_marginals(problem: AssignmentProblem, logw: np.ndarray,
                     max_nodes: int = MAX_NODES) -> ExactResult:
     """Exact marginals of every cluster of ``problem`` whose net fits (log weights
     ``logw`` of the candidates); see the module docstring."""
-    from ..solvers.kernels import ensure
-    from ..solvers.kernels.ehm_exact import exact_marginals as kernel
+    from ..solvers.kernels import pick
 
     E = np.ascontiguousarray(problem.entry_rows, np.int64)
     args = (E, np.ascontiguousarray(logw, np.float64), int(problem.n_rows), int(max_nodes))
-    ensure(kernel, *args)
+    kernel = pick("ehm_exact.exact_marginals", *args, work=len(E))
     label, cand_label, P, log_z, status, nodes, width = kernel(*args)
     return ExactResult(P, log_z, status, nodes, width, label, cand_label)
 

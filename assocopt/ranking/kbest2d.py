@@ -114,8 +114,7 @@ def kbest_2d(problem: AssignmentProblem, k: int) -> tuple[list[Solution], bool, 
                                                           dict[str, float]] | None:
     """``(solutions best first, exhausted, subproblems solved, kernel times)`` of a
     2-D problem, or None when it is not for this path (empty side, too large)."""
-    from ..solvers.kernels import ensure, spent
-    from ..solvers.kernels.murty2d import murty
+    from ..solvers.kernels import pick, spent
 
     d = problem.dense_view
     n1, n2 = problem.sizes
@@ -132,8 +131,7 @@ def kbest_2d(problem: AssignmentProblem, k: int) -> tuple[list[Solution], bool, 
     tol = 1e-9 * max(1.0, float(finite.max()) if finite.size else 1.0)
     k = min(k, 2**62)              # the kernel counts in int64
     k0 = spent()
-    if not getattr(murty, "overloads", True):   # the one signature, once a process
-        ensure(murty, form.A, form.P, k, tol)     # (NUMBA_DISABLE_JIT: a plain function)
+    murty = pick("murty2d.murty", form.A, form.P, k, tol, work=min(k, 10**9) * form.A.size)
     k1 = spent()
     X, _, n, exhausted, solved = murty(form.A, form.P, k, tol)
     X = np.where(X < form.n_real_cols, X, -1)

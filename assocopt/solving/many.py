@@ -97,7 +97,7 @@ def _solve_batch(probs: list[AssignmentProblem], solver: str) -> list[Solution |
     axes, costs out of range), or did not settle (infeasible, node budget spent)."""
     from ..solvers.bnb.backend import MAX_KEPT
     from ..solvers.bnb.batch import run_batch
-    from ..solvers.kernels.driver import PROVEN
+    from ..solvers.kernels.outcomes import PROVEN
     from ..solvers.scaling import SCALE_ABOVE
     from .choice import BNB_MAX_KEPT
 

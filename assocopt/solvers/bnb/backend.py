@@ -73,7 +73,7 @@ from ...model.solution import Status
 from ...problems.problem import OPT_TOL
 from ..base import (Backend, Option, RawResult, SolveOptions, _distribution_version,
                    empty_answer, get_backend, register)
-from ..interruptible import new_stop, run_stoppable
+from ..interruptible import new_stop, run_tiered
 
 __all__ = ["BranchBoundBackend", "DEFAULTS", "BnbInput", "MAX_DENSE", "MAX_KEPT",
            "kept_sizes", "too_large"]
@@ -138,9 +138,9 @@ class BnbInput:
         c = np.ascontiguousarray(problem.costs, np.float64)
         args = (problem.tuples, problem.row_offsets, np.asarray(problem.sizes, np.int64),
                 c, a, b)
-        kern.ensure(kern.prepare, *args)
+        prepare = kern.pick(kern.name("prepare"), *args, work=problem.n_candidates)
         with kern.uninterrupted():      # a Ctrl-C inside numba's call crashed the process
-            G, ptr, lst, y0, axis_of, int_costs, plain = kern.prepare(*args)
+            G, ptr, lst, y0, axis_of, int_costs, plain = prepare(*args)
         return cls(G=G, c=c, a=a, b=b, relaxed=relaxed, off=problem.row_offsets,
                    plain=bool(plain), axis_of=axis_of, ptr=ptr, lst=lst,
                    int_costs=bool(int_costs), y0=y0)
@@ -179,7 +179,7 @@ class BranchBoundBackend(Backend):
 
     name = "bnb"
     module = "numba"
-    imports = ("numba",)
+    imports = ()             # numba: only when a kernel is compiled (kernels.tiers)
     distribution = "numba"
     description = ("compiled Lagrangian-bounded exact-cover branch and bound "
                    "(numba; small S-D problems)")
@@ -192,7 +192,7 @@ class BranchBoundBackend(Backend):
         p = self.settings(problem, options)
         if (empty := empty_answer(problem, options, self.name)) is not None:
             return empty
-        from . import kernels as kern      # imports numba: only when asked for
+        from . import kernels as kern      # numba: imported when a kernel compiles
         t0 = time.perf_counter()
         k0 = sum(kern.spent())    # compile / cache load: reported apart (api.solve)
 
@@ -220,14 +220,14 @@ class BranchBoundBackend(Backend):
             p["probe_every"], probe_nodes, p["max_nodes"], p["step0"], p["patience"],
             p["step_min"], p["deflect"], p["recover_every"], n3, off_c, n_c,
             p["warm_start"], p["stall_tol"], stop)
-        kern.ensure(kern.solve, *args)
+        kern.pick(kern.name("solve"), *args, work=problem.n_candidates)   # compile now
         t_build = time.perf_counter() - t0 - (sum(kern.spent()) - k0)
         t1 = time.perf_counter()
         # the limit counts building, not the one-off compilation / cache load
         deadline = None if options.time_limit is None else \
             t1 + max(options.time_limit - t_build, 0.0)
-        (out, sel, n_sel, ub, bound, iters, nodes), by_clock = run_stoppable(
-            kern.solve, args, stop, deadline=deadline,
+        (out, sel, n_sel, ub, bound, iters, nodes), by_clock = run_tiered(
+            kern.name("solve"), args, stop, work=problem.n_candidates, deadline=deadline,
             inline=problem.n_candidates <= INLINE_CANDIDATES)
         dt = t_build + time.perf_counter() - t1
         params = {k: v for k, v in p.items()}

@@ -19,7 +19,7 @@ import numpy as np
 from ...model.solution import Status
 from ..base import SolveOptions
 from .backend import DEFAULTS, INLINE_CANDIDATES, TOL
-from ..interruptible import new_stop, run_stoppable
+from ..interruptible import new_stop, run_tiered
 
 __all__ = ["solve_components", "batch_arrays", "run_batch"]
 
@@ -39,17 +39,16 @@ def run_batch(T: np.ndarray, c: np.ndarray, kp: np.ndarray, sizes: np.ndarray,
               ) -> tuple[tuple[np.ndarray, ...], bool]:
     """The kernel on ``(T, c, kp, sizes)`` (local tuples, ``sizes`` (parts, N)):
     ``((outcome, ub, bound, chosen), stopped_by_clock)``."""
-    from ..kernels import ensure
-    from ..kernels.batch import solve_batch
     p = dict(DEFAULTS, **(params or {}))
     args = (np.ascontiguousarray(T, np.int64), np.ascontiguousarray(c, np.float64),
             kp, np.ascontiguousarray(sizes, np.int64), TOL, p["max_iter"],
             p["probe_every"], p["probe_nodes"], p["max_nodes"], p["step0"], p["patience"],
             p["step_min"], p["deflect"], p["recover_every"], p["warm_start"],
             p["stall_tol"], new_stop())
-    ensure(solve_batch, *args)
-    return run_stoppable(solve_batch, args, args[-1], deadline=deadline,
-                         inline=len(T) <= INLINE_CANDIDATES)
+    from ..kernels import pick
+    pick("batch.solve_batch", *args, work=len(T))      # compile now (timed apart)
+    return run_tiered("batch.solve_batch", args, args[-1], work=len(T), deadline=deadline,
+                      inline=len(T) <= INLINE_CANDIDATES)
 
 
 def solve_components(problem: Any, T: np.ndarray, csizes: np.ndarray, sp: Any,
@@ -70,7 +69,7 @@ def solve_components(problem: Any, T: np.ndarray, csizes: np.ndarray, sp: Any,
     deadline = None if left is None else time.perf_counter() + max(left, 0.0)
     (outcome, ub, lb, chosen), by_clock = run_batch(Tb, cb, kp, csizes[comps], params,
                                                     deadline)
-    from ..kernels.driver import INFEASIBLE, PROVEN
+    from ..kernels.outcomes import INFEASIBLE, PROVEN
     proven = outcome == PROVEN
     found = np.isfinite(ub)
     cand = np.concatenate(parts)

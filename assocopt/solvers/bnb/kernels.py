@@ -2,8 +2,8 @@
 method with duals, the Lagrangian relaxation to a 2-D assignment with misses, and a
 depth-first exact-cover branch and bound on reduced costs.
 
-Importing this module imports numba; :mod:`assocopt.solvers.bnb.backend` does so only inside
-``solve``.  Functions are compiled on first use and cached on disk (``cache=True``).
+The kernels are imported (and numba with them) on first access; :mod:`assocopt.solvers.bnb.backend`
+asks for them by name (:func:`name`) where a small problem may run them interpreted.  Functions are compiled on first use and cached on disk (``cache=True``).
 
 Notation (as in :mod:`assocopt.solvers.lagrangian`): ``K`` candidates, ``N`` axes,
 ``G[k, s]`` the global row of the real index of candidate ``k`` on axis ``s`` (-1 for
@@ -19,13 +19,30 @@ the ascent only makes it tight.
 
 from typing import Any
 
-from ..kernels import ensure, spent, uninterrupted  # noqa: F401  (compile clock; Ctrl-C)
-from ..kernels.driver import (INFEASIBLE, PROVEN, STOPPED, recover3, solve,  # noqa: F401
-                             tuple_index)
-from ..kernels.hungarian import hungarian, hungarian_warm  # noqa: F401
-from ..kernels.relaxation import (evaluate, full_reduced, improve_limit,  # noqa: F401
-                                 prepare, raise_rows, reduced, sort_lists)
-from ..kernels.search import BUDGET, COMPLETE, dfs  # noqa: F401
+from ..kernels import ensure, pick, spent, uninterrupted  # noqa: F401  (compile clock; Ctrl-C)
+from ..kernels.outcomes import BUDGET, COMPLETE, INFEASIBLE, PROVEN, STOPPED  # noqa: F401
+
+#: The kernels, by the module of :mod:`assocopt.solvers.kernels` that holds them:
+#: imported (with numba) on first access, so that a caller that runs them
+#: interpreted (:func:`assocopt.solvers.kernels.pick` given a name) never loads numba.
+_WHERE = {"recover3": "driver", "solve": "driver", "tuple_index": "driver",
+          "hungarian": "hungarian", "hungarian_warm": "hungarian",
+          "evaluate": "relaxation", "full_reduced": "relaxation",
+          "improve_limit": "relaxation", "prepare": "relaxation",
+          "raise_rows": "relaxation", "reduced": "relaxation",
+          "sort_lists": "relaxation", "dfs": "search"}
+
+
+def name(kernel: str) -> str:
+    """``"relaxation.prepare"``: the name :func:`pick` takes for a ``bnb`` kernel."""
+    return f"{_WHERE[kernel]}.{kernel}"
+
+
+def __getattr__(attr: str) -> Any:
+    if attr in _WHERE:
+        from ..kernels import tiers
+        return tiers.compiled(name(attr))
+    raise AttributeError(f"module {__name__!r} has no attribute {attr!r}")
 
 
 def cached(*kernels: Any) -> bool:
@@ -36,6 +53,6 @@ def cached(*kernels: Any) -> bool:
     import os
     try:
         return all(os.path.exists(f._cache._cache_file._index_path)
-                   for f in (kernels or (solve, prepare)))
+                   for f in (kernels or (__getattr__("solve"), __getattr__("prepare"))))
     except Exception:
         return True

@@ -31,7 +31,7 @@ import logging
 import time
 from typing import Any, Iterator
 
-__all__ = ["ensure", "spent", "announced", "defer_interrupt",
+__all__ = ["ensure", "pick", "spent", "announced", "defer_interrupt",
            "uninterrupted"]
 
 _LOG = logging.getLogger("assocopt")
@@ -126,6 +126,32 @@ def ensure(kernel: Any, *args: Any) -> None:
     dt = time.perf_counter() - t0
     _SPENT["cache_load" if sum(kernel.stats.cache_hits.values()) > hits else "compile"] += dt
     _SEEN.add(key)
+
+
+def pick(kernel: Any, *args: Any, work: float) -> Any:
+    """The function to call for ``kernel(*args)`` (a kernel or its name,
+    ``"driver.solve"``: a name imports neither the kernel nor numba unless needed):
+    the kernel itself, compiled (or loaded) for these arguments by :func:`ensure`, or
+    its plain-Python twin where that costs less (:mod:`.tiers`: small ``work``, no
+    machine code in this process, the interpreted budget not spent)."""
+    from . import tiers
+
+    name = tiers.key(kernel)
+    if tiers.interpret(name, work, lambda: _cached(tiers.compiled(name), args)):
+        return tiers.plain(name)
+    kernel = tiers.compiled(name)
+    if hasattr(kernel, "py_func"):               # (NUMBA_DISABLE_JIT: a plain function)
+        ensure(kernel, *args)
+    return kernel
+
+
+def _cached(kernel: Any, args: tuple) -> bool:
+    """Whether numba's disk cache holds ``kernel`` for the types of ``args``."""
+    try:
+        sig = tuple(kernel.typeof_pyval(a) for a in args)
+    except Exception:
+        return False
+    return _on_disk(kernel, sig)
 
 
 def _on_disk(kernel: Any, sig: tuple) -> bool:

@@ -93,10 +93,7 @@ def recover3(c, pa, pb, chosen, idx, nb, nc, sel, sparse=True):
     return n, cost
 
 
-# solve() outcomes
-PROVEN = 0         # incumbent optimal (or infeasible if there is none)
-STOPPED = 1        # budget spent: incumbent (if any) and a bound
-INFEASIBLE = 2     # the kept axes admit no assignment
+from .outcomes import INFEASIBLE, PROVEN, STOPPED  # noqa: E402  (solve()'s outcomes)
 
 
 @njit(cache=True, nogil=True)

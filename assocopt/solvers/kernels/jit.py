@@ -56,9 +56,17 @@ class CachePolicy(NamedTuple):
     reason: str
 
 
+#: This module loaded as part of the kernels' plain-Python twins (:mod:`.tiers`):
+#: :func:`njit` returns each function unchanged and numba is never imported.
+PLAIN = __name__.endswith("._plain.jit")
+
+
 def njit(*args: Any, **options: Any) -> Any:
     """``numba.njit`` (same arguments: ``cache``, ``nogil``, ``inline``, a signature),
     with ``cache=True`` placed by the policy of this module; bare ``@njit`` works too."""
+    if PLAIN:
+        return args[0] if len(args) == 1 and callable(args[0]) and not options \
+            else (lambda func: func)
     if len(args) == 1 and callable(args[0]) and not options:
         return _decorate(args[0], (), options)
     return lambda func: _decorate(func, args, options)

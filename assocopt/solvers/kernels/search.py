@@ -9,9 +9,7 @@ from .relaxation import improve_limit
 
 INF = np.inf
 
-# DFS outcomes
-COMPLETE = 0       # search exhausted: the incumbent (if any) is optimal
-BUDGET = 1         # node budget spent
+from .outcomes import BUDGET, COMPLETE  # noqa: E402,F401  (dfs() outcomes)
 
 
 @njit(cache=True)

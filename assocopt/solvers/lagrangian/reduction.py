@@ -98,8 +98,7 @@ def _radix(sizes: tuple[int, ...]) -> tuple[np.ndarray, bool]:
 def _dominated_compiled(sizes: tuple[int, ...], T: np.ndarray, c: np.ndarray,
                         nreal: np.ndarray) -> np.ndarray:
     """:func:`dominated` by the compiled kernel (same mask)."""
-    from ..kernels import ensure
-    from ..kernels.dominance import dominated_kernel
+    from ..kernels import pick
     N = T.shape[1]
     off = np.concatenate([[0], np.cumsum(sizes)[:-1]]).astype(np.int64)
     single_cost = np.full(int(sum(sizes)), np.inf)
@@ -109,6 +108,6 @@ def _dominated_compiled(sizes: tuple[int, ...], T: np.ndarray, c: np.ndarray,
     radix, fits = _radix(sizes)
     args = (np.ascontiguousarray(T, np.int64), np.ascontiguousarray(c, np.float64), off,
             radix, single_cost, fits)
-    ensure(dominated_kernel, *args)
-    with np.errstate(over="ignore"):     # the hash wraps (NUMBA_DISABLE_JIT: numpy warns)
-        return dominated_kernel(*args)
+    kernel = pick("dominance.dominated_kernel", *args, work=len(T))
+    with np.errstate(over="ignore"):     # the hash wraps (run as Python: numpy warns)
+        return kernel(*args)

@@ -96,21 +96,23 @@ def _compiled_search(problem: AssignmentProblem, pos: np.ndarray, red: np.ndarra
     c = np.ascontiguousarray(problem.costs[pos], np.float64)
     sizes = np.asarray(problem.sizes, np.int64)
     args = (T, problem.row_offsets, sizes, c, 0, 1)
-    kern.ensure(kern.prepare, *args)         # compile / cache load timed apart
-    G, ptr, lst, _, axis_of, _, _ = kern.prepare(*args)
+    work = len(pos)                          # small: the kernels may run interpreted
+    G, ptr, lst, _, axis_of, _, _ = kern.pick(kern.name("prepare"), *args,
+                                              work=work)(*args)
     rp = np.ascontiguousarray(red, np.float64)
-    kern.ensure(kern.improve_limit, cap, integer, OPT_TOL)
-    limit = kern.improve_limit(cap, integer, OPT_TOL)
-    kern.ensure(kern.sort_lists, ptr, lst, rp, limit - base)
-    sptr, slst = kern.sort_lists(ptr, lst, rp, limit - base)
+    limit = kern.pick(kern.name("improve_limit"), cap, integer, OPT_TOL,
+                      work=work)(cap, integer, OPT_TOL)
+    sptr, slst = kern.pick(kern.name("sort_lists"), ptr, lst, rp, limit - base,
+                           work=work)(ptr, lst, rp, limit - base)
     best = np.full(problem.n_rows + 1, -1, np.int64)
-    from ..interruptible import new_stop, run_stoppable
+    from ..interruptible import new_stop, run_tiered
 
     stop = new_stop()
     args = (G, c, rp, base, sptr, slst, axis_of, problem.ndim, integer, OPT_TOL, cap,
             best, -1, node_limit, stop)
-    kern.ensure(kern.dfs, *args)
-    (out, _, n, _), _ = run_stoppable(kern.dfs, args, stop, inline=node_limit <= 20_000)
+    kern.pick(kern.name("dfs"), *args, work=work)     # compile now (timed apart)
+    (out, _, n, _), _ = run_tiered(kern.name("dfs"), args, stop, work=work,
+                                   inline=node_limit <= 20_000)
     return (pos[best[:n]] if n > 0 else None), out == kern.COMPLETE
 
 

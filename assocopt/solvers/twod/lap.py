@@ -201,12 +201,10 @@ def _compiled_sparse() -> bool:
 def _compiled_lap(size: int, rows, cols, weights) -> tuple[np.ndarray, np.ndarray]:
     """A perfect matching of the square edge list by the compiled sparse LAP (no scipy
     matrix built per call, which the Lagrangian ascent makes hundreds of times)."""
-    from ..kernels import ensure
-    from ..kernels.sparse_lap import lap_edges
+    from ..kernels import pick
     args = (size, size, np.ascontiguousarray(rows, np.int64),
             np.ascontiguousarray(cols, np.int64), np.ascontiguousarray(weights, np.float64))
-    ensure(lap_edges, *args)
-    edge, bad = lap_edges(*args)
+    edge, bad = pick("sparse_lap.lap_edges", *args, work=len(args[4]))(*args)
     if bad >= 0:
         raise LapInfeasibleError("no perfect matching of the augmented edges")
     return np.arange(size), args[3][edge]

@@ -178,8 +178,8 @@ def _lap(nr: int, nc: int, rows: np.ndarray, cols: np.ndarray, w: np.ndarray,
     if kernel is None:
         edge = _scipy_edges(nr, nc, rows, cols, w)
     else:
-        from ..kernels import ensure
-        ensure(kernel, nr, nc, rows, cols, w)
+        from ..kernels import pick
+        kernel = pick(kernel, nr, nc, rows, cols, w, work=len(w))
         edge, bad = kernel(nr, nc, rows, cols, w)
         if bad >= 0:
             raise LapInfeasibleError(_NO_ASSIGNMENT)
@@ -207,12 +207,11 @@ def _scipy_edges(nr: int, nc: int, rows: np.ndarray, cols: np.ndarray,
 _KERNEL: list = []
 
 
-def _kernel():
-    """The compiled LAP (imported on first use: importing numba costs), or None."""
+def _kernel() -> str | None:
+    """The compiled LAP's name for :func:`assocopt.solvers.kernels.pick` (which runs it
+    compiled or, on a small problem, interpreted), or None without numba."""
     if not _KERNEL:
-        try:
-            from ..kernels.sparse_lap import lap_edges
-        except ImportError:
-            lap_edges = None
-        _KERNEL.append(lap_edges)
+        import importlib.util
+        _KERNEL.append("sparse_lap.lap_edges" if importlib.util.find_spec("numba")
+                       else None)
     return _KERNEL[0]

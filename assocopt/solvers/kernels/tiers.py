@@ -1,0 +1,183 @@
+"""Compiled or plain Python: each kernel call takes the route that costs less.
+
+A numba kernel costs seconds to compile on first use (tens of seconds for the branch
+and bound) and a fraction of a second to load from the disk cache, while the same
+function run as plain Python answers a small problem in milliseconds: the problems of
+a first CLI run, of a pytest optimality check or of a notebook's first cell.  So a
+call that asks for a kernel (:func:`assocopt.solvers.kernels.pick`) with a measure of
+its ``work`` runs the kernel *interpreted* (the same source, loaded a second time as
+plain Python, numba not involved: :func:`plain`) while
+
+* the kernel has no machine code in this process yet,
+* the work is at most the kernel's :data:`LIMITS` entry (problems where the plain
+  function answers within about a tenth of a second), and
+* the interpreted calls of this kernel have cost less than the budget so far:
+  :data:`BUDGET_COLD` seconds when the kernel would have to be compiled,
+  :data:`BUDGET_CACHED` when numba's disk cache holds it (loading is cheaper);
+
+otherwise it is compiled (or loaded) and runs compiled from then on.  That is the
+ski-rental rule: a process that keeps calling pays at most its budget before it
+compiles, one that calls a few times never compiles.  Kernels with a stop flag (the
+searches) are also given the rest of the budget as a deadline
+(:func:`assocopt.solvers.interruptible.run_tiered`): a hard small problem that runs
+past it is solved again compiled.  Both routes give the same answers (the kernels are
+written so that they run as plain Python: ``NUMBA_DISABLE_JIT=1`` is tested).
+
+``ASSOCOPT_JIT`` (environment, read at each decision) or :func:`set_mode` choose:
+``auto`` (the rule above, default), ``compiled`` (always compile) or ``interpreted``
+(never compile).
+
+May import: the standard library and the package file (its clock); the kernel modules
+(numpy; the compiled ones numba) only when a kernel is asked for.
+"""
+
+from __future__ import annotations
+
+import importlib
+import os
+import sys
+import threading
+import time
+import types
+from typing import Any, Callable
+
+__all__ = ["MODES", "LIMITS", "BUDGET_COLD", "BUDGET_CACHED", "mode", "set_mode",
+           "interpret", "plain", "compiled", "interpreted_seconds", "exhaust"]
+
+MODES = ("auto", "compiled", "interpreted")
+
+#: Interpreted seconds a kernel may cost in one process before it is compiled anyway,
+#: when numba would compile it (cold) and when its disk cache holds it (cached).
+BUDGET_COLD = 2.0
+BUDGET_CACHED = 0.3
+
+#: Largest ``work`` of an interpreted call, per kernel (``module.function``); the unit
+#: is the one its call site passes.  Set where the plain function takes about a tenth
+#: of a second on 2 cores (measured per unit on the first-use paths: the searches,
+#: whose time a size does not bound, also stop at the budget).  A kernel missing here
+#: always runs compiled.
+LIMITS: dict[str, float] = {
+    "relaxation.prepare": 20_000,         # candidates (about 7 us each)
+    "relaxation.improve_limit": 20_000,
+    "relaxation.sort_lists": 20_000,
+    "driver.solve": 5_000,                # candidates; stops at the budget
+    "search.dfs": 5_000,                  # candidates; stops at the budget
+    "batch.solve_batch": 10_000,          # candidates of all components (about 20 us)
+    "dominance.dominated_kernel": 30_000,  # candidates (about 3 us)
+    "sparse_lap.lap_edges": 30_000,       # edges (about 4 us)
+    "murty2d.murty": 30_000,              # solutions x matrix entries (about 5 us)
+    "ehm_exact.exact_marginals": 100,     # candidates (about 1.3 ms: hashed nets)
+}
+
+_MODE: list[str | None] = [None]
+_SPENT: dict[str, float] = {}
+_LOCK = threading.Lock()
+_HOME = __name__.rsplit(".", 1)[0]
+_PKG = _HOME + "._plain"
+
+
+def mode() -> str:
+    """The route rule now: :func:`set_mode`'s, else ``ASSOCOPT_JIT``, else ``auto``."""
+    m = _MODE[0] or os.environ.get("ASSOCOPT_JIT", "").strip().lower() or "auto"
+    if m not in MODES:
+        raise ValueError(f"ASSOCOPT_JIT={m!r}: expected one of {', '.join(MODES)}")
+    return m
+
+
+def set_mode(value: str | None) -> None:
+    """Fix the route rule for this process (``None``: back to ``ASSOCOPT_JIT``)."""
+    if value is not None and value not in MODES:
+        raise ValueError(f"mode {value!r}: expected one of {', '.join(MODES)} or None")
+    _MODE[0] = value
+
+
+def key(kernel: Any) -> str:
+    """``"driver.solve"``: the kernel's module (last part) and name (a name is kept)."""
+    if isinstance(kernel, str):
+        return kernel
+    fn = getattr(kernel, "py_func", kernel)
+    return f"{fn.__module__.rsplit('.', 1)[-1]}.{fn.__name__}"
+
+
+def loaded(name: str) -> Any:
+    """The compiled kernel ``name`` if its module is imported already, else None."""
+    module, func = name.rsplit(".", 1)
+    mod = sys.modules.get(f"{_HOME}.{module}")
+    return None if mod is None else getattr(mod, func)
+
+
+def compiled(name: str) -> Any:
+    """The compiled kernel ``name``; importing its module (and numba, the first time:
+    about half a second) is timed as loading kernels (``times["cache_load"]``)."""
+    module, func = name.rsplit(".", 1)
+    full = f"{_HOME}.{module}"
+    mod = sys.modules.get(full)
+    if mod is None:
+        from . import _SPENT as clock
+        t0 = time.perf_counter()
+        mod = importlib.import_module(full)
+        clock["cache_load"] += time.perf_counter() - t0
+    return getattr(mod, func)
+
+
+def interpret(name: str, work: float, cached: Callable[[], bool]) -> bool:
+    """Whether a call of kernel ``name`` with ``work`` runs interpreted (module doc);
+    ``cached()`` tells whether numba's disk cache holds it (asked only if it matters)."""
+    m = mode()
+    if m != "auto":
+        return m == "interpreted"
+    if getattr(loaded(name), "overloads", None):     # machine code in this process
+        return False
+    if work > LIMITS.get(name, -1.0):
+        return False
+    spent = _SPENT.get(name, 0.0)
+    return spent < BUDGET_COLD and (spent < BUDGET_CACHED or not cached())
+
+
+def budget_left(name: str) -> float:
+    """Seconds the interpreted route of kernel ``name`` may still cost (cold budget)."""
+    return max(BUDGET_COLD - _SPENT.get(name, 0.0), 0.0)
+
+
+def exhaust(name: str) -> None:
+    """Close the interpreted route of kernel ``name`` for this process (a call ran
+    past its budget): it is compiled from the next call on."""
+    with _LOCK:
+        _SPENT[name] = max(_SPENT.get(name, 0.0), BUDGET_COLD)
+
+
+def interpreted_seconds() -> dict[str, float]:
+    """Seconds spent in interpreted kernels so far, per kernel."""
+    return dict(_SPENT)
+
+
+def plain(name: str) -> Callable:
+    """Kernel ``name`` as plain Python, its callees plain too, timed into its budget."""
+    module, func = name.rsplit(".", 1)
+    twin = getattr(_twin(module), func)
+
+    def timed(*args: Any) -> Any:
+        t0 = time.perf_counter()
+        try:
+            return twin(*args)
+        finally:
+            with _LOCK:
+                _SPENT[name] = _SPENT.get(name, 0.0) + time.perf_counter() - t0
+
+    timed.__name__ = func
+    timed.__wrapped__ = twin                         # type: ignore[attr-defined]
+    timed.interpreted = True                         # type: ignore[attr-defined]
+    return timed
+
+
+def _twin(name: str) -> types.ModuleType:
+    """The kernel module ``name`` loaded again, as plain Python, under ``_plain``: a
+    package whose path is this folder, so that the twin's relative imports load twins
+    and its ``njit`` (``_plain.jit``) returns the functions unchanged."""
+    with _LOCK:
+        if _PKG not in sys.modules:
+            pkg = types.ModuleType(_PKG, "plain-Python twins of the kernels")
+            pkg.__path__ = [os.path.dirname(os.path.abspath(__file__))]
+            pkg.__package__ = _PKG
+            sys.modules[_PKG] = pkg
+    return importlib.import_module(f"{_PKG}.{name}")
