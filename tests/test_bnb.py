@@ -210,6 +210,7 @@ def test_cli_says_when_it_compiles(monkeypatch, capsys):
     # a one-shot default solve of a stored instance this small goes to HiGHS (no
     # kernels to load): bnb asked for by name
     example = Path(__file__).resolve().parents[1] / "instances" / "sd-bearing-3s.json"
+    monkeypatch.setenv("ASSOCOPT_JIT", "compiled")      # small: else run interpreted
     monkeypatch.setattr(kern, "cached", lambda: False)
     assert main(["solve", str(example), "--solver", "bnb"]) == 0
     err = capsys.readouterr().err
@@ -237,6 +238,7 @@ def test_cli_prints_how_long_compilation_took(monkeypatch, capsys):
         sol.times["compile"] = 12.34
         return sol
     monkeypatch.setattr(assocopt.solving.api, "solve", compiled)
+    monkeypatch.setenv("ASSOCOPT_JIT", "compiled")
     monkeypatch.setattr(kern, "cached", lambda: True)
     assert main(["solve", str(example), "--solver", "bnb"]) == 0
     assert capsys.readouterr().err == ("assocopt: compiled the numba kernels in 12.3 s "
@@ -253,6 +255,7 @@ def test_compile_and_cache_load_are_reported_apart(monkeypatch):
     times["cache_load"] (and info fields), and is not counted in build or solve."""
     from assocopt.solvers import kernels
 
+    monkeypatch.setenv("ASSOCOPT_JIT", "compiled")
     p = AssignmentProblem.dense(np.random.default_rng(3).random((4, 4, 4)))
     solve(p, "bnb")                              # kernels in memory now
     warm = solve(p, "bnb")
@@ -263,7 +266,7 @@ def test_compile_and_cache_load_are_reported_apart(monkeypatch):
     def slow_ensure(kernel, *args):
         calls.append(kernel)
         kernels._SPENT["cache_load"] += 0.5      # as if loading took half a second
-    monkeypatch.setattr(kern, "ensure", slow_ensure)
+    monkeypatch.setattr(kernels, "ensure", slow_ensure)   # pick() compiles through it
     sol = solve(p, "bnb")
     assert {kern.prepare, kern.solve} <= set(calls)
     assert sol.times["cache_load"] == pytest.approx(0.5 * len(calls))
@@ -311,7 +314,7 @@ def test_a_bnb_solve_loads_only_the_kernels_it_calls():
             "sol = solve(p, 'bnb')\n"
             "names = ['prepare', 'solve']\n"
             "print(json.dumps({n: len(getattr(k, n).overloads) for n in names}))\n")
-    env = dict(os.environ, PYTHONPATH=str(root))
+    env = dict(os.environ, PYTHONPATH=str(root), ASSOCOPT_JIT="compiled")
     out = subprocess.run([sys.executable, "-c", code], env=env, capture_output=True,
                          text=True, check=True, timeout=600).stdout
     loaded = json.loads(out.splitlines()[-1])

@@ -52,8 +52,17 @@ def _same(a, b, path: str = "") -> None:
         assert a == b, (path, a, b)
 
 
+@pytest.fixture
+def compiled_mode():
+    """This process runs every kernel compiled (not as its plain twin) meanwhile."""
+    from assocopt.solvers.kernels import tiers
+    tiers.set_mode("compiled")
+    yield
+    tiers.set_mode(None)
+
+
 @pytest.mark.parametrize("key", KEYS)
-def test_same_answer_without_jit(without_jit, key):
+def test_same_answer_without_jit(without_jit, compiled_mode, key):
     compiled = first_use.run_one(key, small=True)["answer"]
     _same(without_jit[key], compiled, key)
     assert without_jit[key]                           # the path answered something

@@ -117,7 +117,9 @@ def readonly() -> dict:
         env = {k: v for k, v in os.environ.items()
                if not k.startswith("NUMBA_") and k not in ("PYTHONPATH", "PYTHONHOME",
                                                             "XDG_CACHE_HOME")}
-        env.update(HOME=str(home), PYTHONPATH=str(site), PYTHONDONTWRITEBYTECODE="1")
+        # compiled: the point is numba's cache (a small problem would run interpreted)
+        env.update(HOME=str(home), PYTHONPATH=str(site), PYTHONDONTWRITEBYTECODE="1",
+                   ASSOCOPT_JIT="compiled")
         yield {"site": site, "home": home, "prefix": prefix, "env": env}
     finally:
         for path in [base, *base.rglob("*")]:
@@ -168,6 +170,20 @@ def test_cli_solves_a_stored_instance(readonly, solver):
     if solver:
         assert rec["solver"] == solver
         _said_once(done.stderr)
+
+
+def test_a_small_problem_needs_no_cache_at_all(readonly):
+    """By default (``ASSOCOPT_JIT`` unset) a small ``bnb`` solve in the read-only
+    install runs its kernels interpreted: no cache is looked for, nothing is said."""
+    env = {k: v for k, v in readonly["env"].items() if k != "ASSOCOPT_JIT"}
+    done = subprocess.run(readonly["prefix"] + [
+        sys.executable, "-m", "assocopt", "solve", "sd-bearing-3s", "--json", "--solver",
+        "bnb"], cwd=readonly["home"] / "work", env=env, capture_output=True, text=True,
+        timeout=600)
+    assert done.returncode == 0, done.stderr[-3000:]
+    rec = json.loads(done.stdout)
+    assert rec["status"] == "optimal" and rec["matches_recorded_optimum"] is True
+    assert done.stderr == ""
 
 
 _API = textwrap.dedent("""

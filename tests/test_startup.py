@@ -66,13 +66,25 @@ def test_2d_solve_loads_only_its_back_end():
 
 @pytest.mark.skipif(importlib.util.find_spec("numba") is None, reason="needs numba")
 def test_bnb_solve_loads_numba_but_not_the_other_back_ends():
-    mods = _loaded("from assocopt.cli import main\n"
+    """Compiled (``ASSOCOPT_JIT=compiled``), bnb loads numba and its kernels only."""
+    mods = _loaded("import os; os.environ['ASSOCOPT_JIT'] = 'compiled'\n"
+                   "from assocopt.cli import main\n"
                    "assert main(['solve', 'instances/sd-bearing-3s.json', '--solver', "
                    "'bnb']) == 0")
-    assert "numba" in mods and "assocopt.solvers.bnb.kernels" in mods
+    assert "numba" in mods and "assocopt.solvers.kernels.driver" in mods
     for other in ("highspy", "ortools", "cvxpy", "assocopt.solvers.milp.highs",
                   "assocopt.solvers.lagrangian"):
         assert other not in mods, other
+
+
+def test_a_small_bnb_solve_runs_interpreted_without_numba():
+    """By default a small problem in a fresh process runs bnb's kernels as plain Python
+    (kernels.tiers): numba is not even imported."""
+    mods = _loaded("from assocopt.cli import main\n"
+                   "assert main(['solve', 'instances/sd-bearing-3s.json', '--solver', "
+                   "'bnb']) == 0")
+    assert "numba" not in mods and "assocopt.solvers.kernels._plain.driver" in mods
+    assert "assocopt.solvers.kernels.driver" not in mods
 
 
 def test_tiny_sd_solve_from_the_cli_loads_no_compiled_kernels(capsys):
