@@ -192,14 +192,16 @@ def run_one(key: str, small: bool = False) -> dict[str, Any]:
     call alone: the problem is built first, untimed)."""
     call = {k: f for k, _, f in PATHS}[key](small)
     from assocopt.solvers import kernels
+    from assocopt.solvers.kernels import tiers
 
-    c0 = kernels.spent()
+    c0, i0 = kernels.spent(), sum(tiers.interpreted_seconds().values())
     t0, p0 = time.perf_counter(), time.process_time()
     answer = call()
     wall, cpu = time.perf_counter() - t0, time.process_time() - p0
-    c1 = kernels.spent()
+    c1, i1 = kernels.spent(), sum(tiers.interpreted_seconds().values())
     return {"key": key, "answer": answer, "wall_s": wall, "cpu_s": cpu,
-            "compile_s": c1[0] - c0[0], "cache_load_s": c1[1] - c0[1]}
+            "compile_s": c1[0] - c0[0], "cache_load_s": c1[1] - c0[1],
+            "interpreted_s": i1 - i0, "numba": "numba" in sys.modules}
 
 
 #: Paths the test of NUMBA_DISABLE_JIT runs but the benchmark does not time (the
@@ -211,11 +213,15 @@ def _load() -> list[float]:
     return [round(v, 2) for v in os.getloadavg()]
 
 
-def _fresh(keys: list[str], cache: str) -> dict[str, Any]:
-    """Run ``keys`` in a fresh interpreter with ``NUMBA_CACHE_DIR=cache``: the rows of
-    :func:`run_one` and the process's own wall time (spawn to exit)."""
-    env = {k: v for k, v in os.environ.items() if not k.startswith("NUMBA_")}
+def _fresh(keys: list[str], cache: str, mode: str | None) -> dict[str, Any]:
+    """Run ``keys`` in a fresh interpreter with ``NUMBA_CACHE_DIR=cache`` and
+    ``ASSOCOPT_JIT=mode`` (None: unset, the default rule): the rows of :func:`run_one`
+    and the process's own wall time (spawn to exit)."""
+    env = {k: v for k, v in os.environ.items()
+           if not k.startswith("NUMBA_") and k != "ASSOCOPT_JIT"}
     env.update(NUMBA_CACHE_DIR=cache, PYTHONPATH=str(ROOT))
+    if mode:
+        env["ASSOCOPT_JIT"] = mode
     t0 = time.perf_counter()
     done = subprocess.run([sys.executable, str(Path(__file__).resolve()), "--one", *keys],
                           env=env, cwd=ROOT, capture_output=True, text=True)
@@ -228,47 +234,62 @@ def _fresh(keys: list[str], cache: str) -> dict[str, Any]:
 
 
 def _row(r: dict[str, Any]) -> dict[str, Any]:
-    return {k: round(r[k], 4) for k in ("wall_s", "cpu_s", "compile_s", "cache_load_s")}
+    out = {k: round(r[k], 4) for k in ("wall_s", "cpu_s", "compile_s", "cache_load_s",
+                                        "interpreted_s")}
+    return out | {"numba": r["numba"]}
+
+
+def _together(keys: list[str], mode: str | None) -> dict[str, Any]:
+    """All ``keys`` in one fresh interpreter with an empty cache."""
+    cache = tempfile.mkdtemp(prefix="assocopt-first-use-")
+    try:
+        run = _fresh(keys, cache, mode)
+    finally:
+        shutil.rmtree(cache, ignore_errors=True)
+    rows = run["rows"]
+    return {"wall_s": round(sum(r["wall_s"] for r in rows), 3),
+            "cpu_s": round(sum(r["cpu_s"] for r in rows), 3),
+            "compile_s": round(sum(r["compile_s"] for r in rows), 3),
+            "process_s": round(run["process_s"], 3), "notes": run["notes"],
+            "per_path": {r["key"]: _row(r) for r in rows}}
 
 
 def measure(keys: list[str]) -> dict[str, Any]:
-    """Cold and warm first calls of each path, then all of them in one cold process."""
+    """Per path, three fresh processes on one cache folder: the default rule with the
+    cache empty, compiled with it empty (it fills it), compiled again (it loads);
+    then all paths in one cold process, by the default rule and compiled."""
     load_before = _load()
     rows = []
     for key in keys:
         cache = tempfile.mkdtemp(prefix="assocopt-first-use-")
         try:
-            cold = _fresh([key], cache)
-            warm = _fresh([key], cache)
+            auto = _fresh([key], cache, None)
+            cold = _fresh([key], cache, "compiled")
+            warm = _fresh([key], cache, "compiled")
         finally:
             shutil.rmtree(cache, ignore_errors=True)
         what = {k: w for k, w, _ in PATHS}[key]
-        row = {"key": key, "what": what, "cold": _row(cold["rows"][0]),
-               "warm": _row(warm["rows"][0]), "cold_process_s": round(cold["process_s"], 3),
-               "warm_process_s": round(warm["process_s"], 3),
-               "cold_notes": cold["notes"], "warm_notes": warm["notes"],
-               "load": _load()}
+        row = {"key": key, "what": what, "auto": _row(auto["rows"][0]),
+               "cold": _row(cold["rows"][0]), "warm": _row(warm["rows"][0]),
+               "auto_notes": auto["notes"], "cold_notes": cold["notes"],
+               "warm_notes": warm["notes"], "load": _load()}
         rows.append(row)
-        print(f"{key:<17} cold {row['cold']['wall_s']:7.2f} s (CPU {row['cold']['cpu_s']:.2f}, "
-              f"compile {row['cold']['compile_s']:.2f})  warm {row['warm']['wall_s']:.3f} s "
-              f"(load {row['warm']['cache_load_s']:.3f})  load avg {row['load']}", flush=True)
-    cache = tempfile.mkdtemp(prefix="assocopt-first-use-")
-    try:
-        together = _fresh(keys, cache)
-    finally:
-        shutil.rmtree(cache, ignore_errors=True)
-    all_rows = together["rows"]
-    total = {"wall_s": round(sum(r["wall_s"] for r in all_rows), 3),
-             "cpu_s": round(sum(r["cpu_s"] for r in all_rows), 3),
-             "compile_s": round(sum(r["compile_s"] for r in all_rows), 3),
-             "process_s": round(together["process_s"], 3), "notes": together["notes"],
-             "per_path": {r["key"]: _row(r) for r in all_rows}}
-    print(f"all together: {total['wall_s']:.2f} s (CPU {total['cpu_s']:.2f})", flush=True)
+        print(f"{key:<17} default {row['auto']['wall_s']:.3f} s (CPU "
+              f"{row['auto']['cpu_s']:.3f})  compiled cold {row['cold']['wall_s']:7.2f} s "
+              f"(CPU {row['cold']['cpu_s']:.2f})  warm {row['warm']['wall_s']:.3f} s  "
+              f"load avg {row['load']}", flush=True)
+    together = {"auto": _together(keys, None), "compiled": _together(keys, "compiled")}
+    for mode, t in together.items():
+        print(f"all together ({mode}): {t['wall_s']:.2f} s (CPU {t['cpu_s']:.2f})",
+              flush=True)
+    from assocopt.solvers.kernels import tiers
     return {"targets": {"cold_s": COLD_TARGET, "all_s": ALL_TARGET, "warm_s": WARM_TARGET},
             "machine": {"python": platform.python_version(), "system": platform.system(),
                         "machine": platform.machine(), "cpus": os.cpu_count()},
             "versions": _versions(), "load_before": load_before, "load_after": _load(),
-            "rows": rows, "together": total}
+            "rule": {"budget_cold_s": tiers.BUDGET_COLD,
+                     "budget_cached_s": tiers.BUDGET_CACHED, "limits": dict(tiers.LIMITS)},
+            "rows": rows, "together": together}
 
 
 def _versions() -> dict[str, str]:
@@ -282,75 +303,7 @@ def _versions() -> dict[str, str]:
     return out
 
 
-def _met(value: float, target: float) -> str:
-    return "yes" if value <= target else "no"
-
-
-def render(data: dict[str, Any]) -> str:
-    """The docs page for the measurements ``data`` (tests/test_benchmarks_first_use.py
-    checks that the committed page is this function of the committed json)."""
-    m, v, t = data["machine"], data["versions"], data["targets"]
-    lines = [
-        "# First use: compiling the kernels",
-        "",
-        "Measured by `python benchmarks/first_use.py` (numbers below from "
-        "`docs/benchmarks-first-use.json`, written by the same run). Each path is one "
-        "public call in a fresh interpreter. *Cold*: `NUMBA_CACHE_DIR` is an empty "
-        "folder, so numba compiles every kernel the call needs; *warm*: a second fresh "
-        "interpreter with that folder filled, so the kernels are loaded from disk. "
-        "Times are of the call alone (wall and CPU of the process from before the call "
-        "to after it; the interpreter's start, `import assocopt` and building the problem "
-        "are not in them); "
-        "*compiling* and *cache load* are the parts of it (wall time) that "
-        "`assocopt.solvers.kernels.ensure` timed; a warm call also imports numba "
-        "(the first kernel a process uses imports it). *Note* says whether the call said, "
-        "before compiling, that it would (one log line of the `assocopt` logger).",
-        "",
-        f"Machine: Python {m['python']}, {m['system']} {m['machine']}, {m['cpus']} CPUs; "
-        f"numpy {v['numpy']}, scipy {v['scipy']}, numba {v['numba']}, llvmlite "
-        f"{v['llvmlite']}. Load average (1, 5, 15 min) before the run "
-        f"{', '.join(f'{x:g}' for x in data['load_before'])}, after it "
-        f"{', '.join(f'{x:g}' for x in data['load_after'])}: on a loaded machine the "
-        "wall times stretch, the CPU times much less.",
-        "",
-        f"Targets: a cold first call at most {t['cold_s']:g} s, all paths in one cold "
-        f"process at most {t['all_s']:g} s, a warm (cached) first call at most "
-        f"{t['warm_s']:g} s; judged here on CPU time.",
-        "",
-        "| path | cold (s) | cold CPU (s) | compiling (s) | note | met | warm (s) | "
-        "cache load (s) | met | load avg |",
-        "|---|---|---|---|---|---|---|---|---|---|",
-    ]
-    for r in data["rows"]:
-        c, w = r["cold"], r["warm"]
-        lines.append(
-            f"| {r['what']} | {c['wall_s']:.2f} | {c['cpu_s']:.2f} | {c['compile_s']:.2f} | "
-            f"{'yes' if r['cold_notes'] else 'no'} | {_met(c['cpu_s'], t['cold_s'])} | "
-            f"{w['wall_s']:.3f} | {w['cache_load_s']:.3f} | "
-            f"{_met(w['cpu_s'], t['warm_s'])} | {r['load'][0]:g} |")
-    tg = data["together"]
-    lines += [
-        "",
-        f"All paths in one cold process, in the order above: {tg['wall_s']:.2f} s "
-        f"({tg['cpu_s']:.2f} s CPU; {tg['compile_s']:.2f} s of the wall time compiling; "
-        "kernels two paths share are compiled once); target met: "
-        f"{_met(tg['cpu_s'], t['all_s'])}. The process as a whole, interpreter start and "
-        f"imports included, took {tg['process_s']:.2f} s.",
-        "",
-        "Where the compile time goes (numba's `numba:compile` events per function and "
-        "signature, measured while cutting it): typing and lowering in numba's Python "
-        "code and LLVM's optimisation of each kernel together with every kernel it "
-        "calls; numba's own library functions (`np.argsort`, array slice assignment with "
-        "its broadcasting checks, `heapq`) are compiled anew for each signature they "
-        "meet. Cut so far: duplicate specialisations (a literal `-1` argument compiled "
-        "`augment` twice; growing arrays by slice assignment compiled numba's "
-        "broadcasting code for each dtype). A read-only install caches in the user's "
-        "cache or, failing that, in a temporary folder of the process, which then "
-        "compiles cold in every new process. `NUMBA_DISABLE_JIT=1` runs every kernel as "
-        "plain Python with the same answers (tests/test_disable_jit.py).",
-        "",
-    ]
-    return "\n".join(lines)
+from first_use_page import render, route  # noqa: E402,F401  (the page, from the JSON)
 
 
 def main(argv: list[str] | None = None) -> int:

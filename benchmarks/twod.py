@@ -27,6 +27,7 @@ import argparse
 import json
 import math
 import platform
+import os
 import sys
 import time
 from pathlib import Path
@@ -35,6 +36,9 @@ from typing import Any, Callable
 import numpy as np
 
 ROOT = Path(__file__).resolve().parents[1]
+# Steady-state speed: the kernels compiled in the warm-up (by default a small problem
+# runs them as plain Python for its first seconds; benchmarks/first_use.py times that)
+os.environ.setdefault("ASSOCOPT_JIT", "compiled")
 sys.path.insert(0, str(ROOT))
 
 from assocopt import AssignmentProblem, kbest, marginals, solve  # noqa: E402
