@@ -199,6 +199,12 @@ class Backend:
     imports: ClassVar[tuple[str, ...]] = ()
 
     @classmethod
+    def imports_for(cls, problem: AssignmentProblem) -> tuple[str, ...]:
+        """:attr:`imports` of a solve of ``problem`` (a back end whose route depends on
+        the problem narrows them)."""
+        return cls.imports
+
+    @classmethod
     def is_native_option(cls, name: str) -> bool:
         """Whether ``name`` is an option of the underlying solver (passed through)."""
         return False

@@ -84,7 +84,8 @@ def solve(problem: AssignmentProblem, solver: str = "auto", *, relax: str | None
     if backend_cls.module is not None and not module_installed(backend_cls.module):
         backend_cls.require()        # cached lookup first: a scan's solve is microseconds
     parsed = backend_cls.parse_options(options)
-    imported = import_missing(backend_cls.imports) if backend_cls.imports else 0.0
+    imported = import_missing(backend_cls.imports_for(problem)) if backend_cls.imports \
+        else 0.0
     if time_limit is None and threads is None and verbose is False and \
             type(mip_gap) is float and mip_gap == 0.0:
         opts = SolveOptions.parsed_defaults(relax, parsed)    # nothing to check

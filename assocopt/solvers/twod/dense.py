@@ -37,7 +37,6 @@ from __future__ import annotations
 import time
 
 import numpy as np
-from scipy.optimize import linear_sum_assignment as _scipy_lsa
 
 from ...model.solution import Status
 from ..base import RawResult, empty_answer
@@ -79,7 +78,8 @@ def _lap(C: np.ndarray, method: str) -> tuple[np.ndarray, np.ndarray]:
     if method != "scipy":
         return linear_assignment(C, method)
     try:
-        return _scipy_lsa(C)
+        from scipy.optimize import linear_sum_assignment   # (imported on first use)
+        return linear_sum_assignment(C)
     except ValueError as exc:
         if "infeasible" in str(exc):
             raise LapInfeasibleError(str(exc)) from exc

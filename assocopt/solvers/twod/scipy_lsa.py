@@ -35,6 +35,14 @@ class ScipyLsaBackend(Backend):
                    "lists)")
     max_ndim = 2
 
+    @classmethod
+    def imports_for(cls, problem: AssignmentProblem) -> tuple[str, ...]:
+        """None for a large gated candidate list (the sparse engine: no scipy.optimize)."""
+        from .sparse import prefer_sparse
+        if problem.dense_view is None and prefer_sparse(problem.sizes, problem.n_candidates):
+            return ()
+        return cls.imports
+
     def solve(self, problem: AssignmentProblem, options: SolveOptions) -> RawResult:
         self.settings(problem, options)          # no options of its own: rejects any
         global _SOLVE_2D
