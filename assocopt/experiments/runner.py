@@ -28,6 +28,14 @@ def _run_chunk(trial_fn, setting: Mapping, skey: str, methods: list[str],
 
     In-process, ``on_result`` stores each trial as soon as it is finished.
     """
+    from ..solvers.kernels.tiers import reproducible
+    with reproducible():              # the kernels compiled: same route in every worker
+        return _run_trials(trial_fn, setting, skey, methods, trials, master, on_result)
+
+
+def _run_trials(trial_fn, setting: Mapping, skey: str, methods: list[str],
+                trials: list[int], master: int, on_result: Callable | None
+                ) -> list[tuple[int, dict, float]]:
     out = []
     for t in trials:
         t0 = time.perf_counter()

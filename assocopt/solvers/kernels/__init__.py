@@ -10,7 +10,9 @@ costs half a second). :mod:`assocopt.solvers.bnb.kernels` is the import point of
 ``bnb`` kernels.
 
 Every kernel is decorated by :func:`.jit.njit` (numba's, with the disk cache placed so
-that a read-only install never fails: see :mod:`.jit`).
+that a read-only install never fails: see :mod:`.jit`).  Callers ask for a kernel
+through :func:`pick`, which on a small problem hands back its plain-Python twin instead
+of compiling it (:mod:`.tiers`).
 
 numba's disk cache does not notice a change in a kernel another file calls: after
 editing ``sap.py``, delete ``__pycache__/murty2d.*.nb[ic]`` (the same holds for

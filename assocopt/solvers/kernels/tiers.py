@@ -25,7 +25,8 @@ written so that they run as plain Python: ``NUMBA_DISABLE_JIT=1`` is tested).
 
 ``ASSOCOPT_JIT`` (environment, read at each decision) or :func:`set_mode` choose:
 ``auto`` (the rule above, default), ``compiled`` (always compile) or ``interpreted``
-(never compile).
+(never compile).  The experiment runner's trials run compiled (:func:`reproducible`):
+their numbers then never depend on which route a trial happened to take.
 
 May import: the standard library and the package file (its clock); the kernel modules
 (numpy; the compiled ones numba) only when a kernel is asked for.
@@ -33,16 +34,18 @@ May import: the standard library and the package file (its clock); the kernel mo
 
 from __future__ import annotations
 
+import contextlib
 import importlib
 import os
 import sys
 import threading
 import time
 import types
-from typing import Any, Callable
+from typing import Any, Callable, Iterator
 
 __all__ = ["MODES", "LIMITS", "BUDGET_COLD", "BUDGET_CACHED", "mode", "set_mode",
-           "interpret", "plain", "compiled", "interpreted_seconds", "exhaust"]
+           "interpret", "plain", "compiled", "interpreted_seconds", "exhaust",
+           "reproducible"]
 
 MODES = ("auto", "compiled", "interpreted")
 
@@ -89,6 +92,22 @@ def set_mode(value: str | None) -> None:
     if value is not None and value not in MODES:
         raise ValueError(f"mode {value!r}: expected one of {', '.join(MODES)} or None")
     _MODE[0] = value
+
+
+@contextlib.contextmanager
+def reproducible() -> Iterator[None]:
+    """Within: every kernel compiled, unless ``ASSOCOPT_JIT`` or :func:`set_mode` chose
+    otherwise.  For Monte Carlo runs: a trial's answers then never depend on how much of
+    the process's interpreted budget earlier trials spent (both routes agree, but a
+    floating-point tie may be decided by the order of a sum)."""
+    chosen = _MODE[0] is not None or os.environ.get("ASSOCOPT_JIT", "").strip()
+    if not chosen:
+        _MODE[0] = "compiled"
+    try:
+        yield
+    finally:
+        if not chosen:
+            _MODE[0] = None
 
 
 def key(kernel: Any) -> str:
