@@ -55,21 +55,22 @@ BUDGET_COLD = 2.0
 BUDGET_CACHED = 0.3
 
 #: Largest ``work`` of an interpreted call, per kernel (``module.function``); the unit
-#: is the one its call site passes.  Set where the plain function takes about a tenth
-#: of a second on 2 cores (measured per unit on the first-use paths: the searches,
-#: whose time a size does not bound, also stop at the budget).  A kernel missing here
-#: always runs compiled.
+#: is the one its call site passes.  Set where the plain function takes about a second
+#: on 2 cores, half the cold budget (measured per unit, interpreted: the batched scan
+#: about 25 us a candidate, the sparse LAP about 3 us an edge, the ranking about 1.5 us
+#: a solution x entry, the exact net about 1.3 ms a candidate); the searches, whose time
+#: no size bounds, also stop at the budget.  A kernel missing here always runs compiled.
 LIMITS: dict[str, float] = {
-    "relaxation.prepare": 20_000,         # candidates (about 7 us each)
-    "relaxation.improve_limit": 20_000,
-    "relaxation.sort_lists": 20_000,
-    "driver.solve": 5_000,                # candidates; stops at the budget
-    "search.dfs": 5_000,                  # candidates; stops at the budget
-    "batch.solve_batch": 10_000,          # candidates of all components (about 20 us)
-    "dominance.dominated_kernel": 30_000,  # candidates (about 3 us)
-    "sparse_lap.lap_edges": 30_000,       # edges (about 4 us)
-    "murty2d.murty": 30_000,              # solutions x matrix entries (about 5 us)
-    "ehm_exact.exact_marginals": 100,     # candidates (about 1.3 ms: hashed nets)
+    "relaxation.prepare": 100_000,        # candidates
+    "relaxation.improve_limit": 100_000,
+    "relaxation.sort_lists": 100_000,
+    "driver.solve": 20_000,               # candidates; stops at the budget
+    "search.dfs": 20_000,                 # candidates; stops at the budget
+    "batch.solve_batch": 40_000,          # candidates of all components; stops too
+    "dominance.dominated_kernel": 300_000,  # candidates
+    "sparse_lap.lap_edges": 300_000,      # edges
+    "murty2d.murty": 200_000,             # solutions x matrix entries
+    "ehm_exact.exact_marginals": 300,     # candidates
 }
 
 _MODE: list[str | None] = [None]
