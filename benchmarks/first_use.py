@@ -179,7 +179,7 @@ PATHS: list[tuple[str, str, Callable[[bool], Callable[[], Any]]]] = [
      path_lagrangian_exact),
     ("sparse2d", "`solve(p)`, a gated 2-D problem, 2000 x 2000 (the sparse LAP)",
      path_sparse2d),
-    ("kbest", "`kbest(p, 10)`, a 2-D problem 8 x 9 with misses (Murty, compiled)",
+    ("kbest", "`kbest(p, 10)`, a 2-D problem 8 x 9 with misses (Murty)",
      path_kbest),
     ("marginals", "`marginals(p, k=50)`, a 2-D problem 8 x 9 with misses", path_marginals),
     ("mfa", "`solve_window(window_problem(...))`, 10 tracks, 3 scans (multi-frame)",
