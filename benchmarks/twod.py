@@ -36,9 +36,6 @@ from typing import Any, Callable
 import numpy as np
 
 ROOT = Path(__file__).resolve().parents[1]
-# Steady-state speed: the kernels compiled in the warm-up (by default a small problem
-# runs them as plain Python for its first seconds; benchmarks/first_use.py times that)
-os.environ.setdefault("ASSOCOPT_JIT", "compiled")
 sys.path.insert(0, str(ROOT))
 
 from assocopt import AssignmentProblem, kbest, marginals, solve  # noqa: E402
@@ -544,4 +541,7 @@ def main(argv: list[str] | None = None) -> int:
 
 
 if __name__ == "__main__":
+    # steady-state speed: the kernels compiled in the warm-up (by default a small
+    # problem runs them as plain Python for its first seconds: first_use.py)
+    os.environ.setdefault("ASSOCOPT_JIT", "compiled")
     sys.exit(main())
