@@ -73,7 +73,8 @@ from ...model.solution import Status
 from ...problems.problem import OPT_TOL
 from ..base import (Backend, Option, RawResult, SolveOptions, _distribution_version,
                    empty_answer, get_backend, register)
-from ..interruptible import new_stop, run_tiered
+from ..interruptible import new_stop
+from .kernels import run_tiered
 
 __all__ = ["BranchBoundBackend", "DEFAULTS", "BnbInput", "MAX_DENSE", "MAX_KEPT",
            "kept_sizes", "too_large"]

@@ -19,7 +19,8 @@ import numpy as np
 from ...model.solution import Status
 from ..base import SolveOptions
 from .backend import DEFAULTS, INLINE_CANDIDATES, TOL
-from ..interruptible import new_stop, run_tiered
+from ..interruptible import new_stop
+from .kernels import run_tiered
 
 __all__ = ["solve_components", "batch_arrays", "run_batch"]
 

@@ -56,3 +56,42 @@ def cached(*kernels: Any) -> bool:
                    for f in (kernels or (__getattr__("solve"), __getattr__("prepare"))))
     except Exception:
         return True
+
+
+def run_tiered(kernel: str, args: tuple, stop: Any, *, work: float,
+               deadline: float | None = None, inline: bool = False) -> tuple[Any, bool]:
+    """:func:`assocopt.solvers.interruptible.run_stoppable` of the kernel named ``kernel`` (``"driver.solve"``) by
+    the route :func:`assocopt.solvers.kernels.pick` chooses for ``work``.
+
+    Interpreted, the call works on copies of the array arguments (copied back when it
+    ends: a kernel may write its answer into one) and gets the rest of the kernel's
+    interpreted budget as a deadline of its own: a small problem that turns out hard
+    runs past it, and is then solved again compiled, from the original arguments, the
+    compilation not counted against ``deadline``."""
+    import time
+
+    import numpy as np
+
+    from ..interruptible import run_stoppable
+    from ..kernels import tiers
+
+    fn = pick(kernel, *args, work=work)
+    if not getattr(fn, "interpreted", False):               # compiled
+        return run_stoppable(fn, args, stop, deadline=deadline, inline=inline)
+    cap = time.perf_counter() + tiers.budget_left(kernel)
+    ours = deadline is None or cap < deadline
+    copies = tuple(a.copy() if isinstance(a, np.ndarray) and a is not stop else a
+                   for a in args)
+    result, by_clock = run_stoppable(fn, copies, stop, deadline=cap if ours else deadline)
+    if not (by_clock and ours):
+        for a, b in zip(args, copies):       # what the kernel wrote into its arguments
+            if b is not a and a.flags.writeable:
+                a[...] = b
+        return result, by_clock
+    stop[0] = 0
+    tiers.exhaust(kernel)
+    k0 = sum(spent())
+    fn = pick(kernel, *args, work=work)
+    if deadline is not None:
+        deadline += sum(spent()) - k0
+    return run_stoppable(fn, args, stop, deadline=deadline, inline=inline)

@@ -139,11 +139,25 @@ def pick(kernel: Any, *args: Any, work: float) -> Any:
     from . import tiers
 
     name = tiers.key(kernel)
-    if tiers.interpret(name, work, lambda: _cached(tiers.compiled(name), args)):
+    if tiers.interpret(name, work, lambda: _cached(_compiled(name), args)):
         return tiers.plain(name)
-    kernel = tiers.compiled(name)
+    kernel = _compiled(name)
     if hasattr(kernel, "py_func"):               # (NUMBA_DISABLE_JIT: a plain function)
         ensure(kernel, *args)
+    return kernel
+
+
+def _compiled(name: str) -> Any:
+    """The compiled kernel ``name``; importing its module (and numba, the first time:
+    about half a second) is timed as loading kernels (``times["cache_load"]``)."""
+    from . import tiers
+
+    if tiers.loaded(name) is not None:
+        return tiers.loaded(name)
+    t0 = time.perf_counter()
+    kernel = tiers.compiled(name)
+    if hasattr(kernel, "py_func"):                # not NUMBA_DISABLE_JIT's plain function
+        _SPENT["cache_load"] += time.perf_counter() - t0
     return kernel
 
 

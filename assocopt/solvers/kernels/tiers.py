@@ -19,7 +19,7 @@ otherwise it is compiled (or loaded) and runs compiled from then on.  That is th
 ski-rental rule: a process that keeps calling pays at most its budget before it
 compiles, one that calls a few times never compiles.  Kernels with a stop flag (the
 searches) are also given the rest of the budget as a deadline
-(:func:`assocopt.solvers.interruptible.run_tiered`): a hard small problem that runs
+(:func:`assocopt.solvers.bnb.kernels.run_tiered`): a hard small problem that runs
 past it is solved again compiled.  Both routes give the same answers (the kernels are
 written so that they run as plain Python: ``NUMBA_DISABLE_JIT=1`` is tested).
 
@@ -28,8 +28,8 @@ written so that they run as plain Python: ``NUMBA_DISABLE_JIT=1`` is tested).
 (never compile).  The experiment runner's trials run compiled (:func:`reproducible`):
 their numbers then never depend on which route a trial happened to take.
 
-May import: the standard library and the package file (its clock); the kernel modules
-(numpy; the compiled ones numba) only when a kernel is asked for.
+May import: the standard library; the kernel modules (numpy; the compiled ones numba)
+only when a kernel is asked for.
 """
 
 from __future__ import annotations
@@ -127,18 +127,9 @@ def loaded(name: str) -> Any:
 
 
 def compiled(name: str) -> Any:
-    """The compiled kernel ``name``; importing its module (and numba, the first time:
-    about half a second) is timed as loading kernels (``times["cache_load"]``)."""
+    """The compiled kernel ``name`` (its module imported, and numba with it)."""
     module, func = name.rsplit(".", 1)
-    full = f"{_HOME}.{module}"
-    mod = sys.modules.get(full)
-    if mod is None:
-        from . import _SPENT as clock
-        t0 = time.perf_counter()
-        mod = importlib.import_module(full)
-        if os.environ.get("NUMBA_DISABLE_JIT", "0") in ("", "0"):     # else: plain
-            clock["cache_load"] += time.perf_counter() - t0
-    return getattr(mod, func)
+    return getattr(importlib.import_module(f"{_HOME}.{module}"), func)
 
 
 def interpret(name: str, work: float, cached: Callable[[], bool]) -> bool:

@@ -105,14 +105,14 @@ def _compiled_search(problem: AssignmentProblem, pos: np.ndarray, red: np.ndarra
     sptr, slst = kern.pick(kern.name("sort_lists"), ptr, lst, rp, limit - base,
                            work=work)(ptr, lst, rp, limit - base)
     best = np.full(problem.n_rows + 1, -1, np.int64)
-    from ..interruptible import new_stop, run_tiered
+    from ..interruptible import new_stop
 
     stop = new_stop()
     args = (G, c, rp, base, sptr, slst, axis_of, problem.ndim, integer, OPT_TOL, cap,
             best, -1, node_limit, stop)
     kern.pick(kern.name("dfs"), *args, work=work)     # compile now (timed apart)
-    (out, _, n, _), _ = run_tiered(kern.name("dfs"), args, stop, work=work,
-                                   inline=node_limit <= 20_000)
+    (out, _, n, _), _ = kern.run_tiered(kern.name("dfs"), args, stop, work=work,
+                                        inline=node_limit <= 20_000)
     return (pos[best[:n]] if n > 0 else None), out == kern.COMPLETE
 
 
