@@ -95,12 +95,22 @@ def test_tiny_sd_solve_from_the_cli_loads_no_compiled_kernels(capsys):
     assert "assocopt.solvers.baseline.bruteforce" in mods
 
 
-def test_small_sd_solve_from_the_cli_goes_to_highs_without_numba():
-    """One S-D problem above the enumeration's size in a fresh process: HiGHS (its
-    import and solve are cheaper than numba's import and bnb's kernels' load)."""
+def test_small_sd_solve_from_the_cli_loads_neither_highs_nor_numba():
+    """One S-D problem above the enumeration's size in a fresh process: auto's bnb with
+    its kernels interpreted (cheaper than HiGHS's import, and no numba)."""
+    mods = _loaded("from assocopt.cli import main\n"
+                   "assert main(['solve', 'instances/sd-bearing-3s.json']) == 0")
+    assert "highspy" not in mods and "numba" not in mods
+    assert "assocopt.solvers.kernels._plain.driver" in mods
+
+
+def test_small_sd_solve_from_the_cli_goes_to_highs_when_compiled():
+    """Compiled (``ASSOCOPT_JIT=compiled``), the one-shot route takes HiGHS: its import
+    and solve are cheaper than numba's import and bnb's kernels' load."""
     if importlib.util.find_spec("highspy") is None:
         pytest.skip("needs highspy")
-    mods = _loaded("from assocopt.cli import main\n"
+    mods = _loaded("import os; os.environ['ASSOCOPT_JIT'] = 'compiled'\n"
+                   "from assocopt.cli import main\n"
                    "assert main(['solve', 'instances/sd-bearing-3s.json']) == 0")
     assert "highspy" in mods and "numba" not in mods
     assert "assocopt.solvers.bnb.kernels" not in mods
@@ -118,10 +128,12 @@ def test_one_shot_highs_answer_equals_auto_in_the_library(capsys):
                  "example-2d-miss", "rect-2d-5x8"):
         path = ROOT / "instances" / f"{name}.json"
         p = read_instance(path)
+        interpreted = p.ndim >= 3 and sc._interpreted(p.n_candidates)
         assert main(["solve", str(path), "--json"]) == 0
         rec = json.loads(capsys.readouterr().out)
         small = p.n_candidates > sc.ONE_SHOT_CANDIDATES or p.ndim == 2
-        want = "highs" if small and p.n_candidates <= sc.ONE_SHOT_HIGHS else None
+        want = "highs" if small and p.n_candidates <= sc.ONE_SHOT_HIGHS \
+            and not interpreted else None
         if want:
             assert rec["solver"] == want and "HiGHS rather than" in rec["message"], name
             assert rec["info"]["one_shot"] is True

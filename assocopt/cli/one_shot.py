@@ -15,7 +15,10 @@ from typing import Any
 #: by ``benchmarks/one_shot.py``, docs/benchmarks-one-shot.md).  So does a 2-D problem
 #: of that size: scipy.optimize, which ``auto``'s 2-D path imports, costs more to
 #: import than HiGHS and scipy.sparse (1.4x the command's CPU seconds measured).
-#: Larger problems, or a search that runs out of nodes, go to ``auto``'s choice.
+#: Larger problems, or a search that runs out of nodes, go to ``auto``'s choice, and so
+#: does an S-D problem whose ``bnb`` kernels would run as plain Python (a fresh process,
+#: the default rule of :mod:`assocopt.solvers.kernels.tiers`: no numba to load, which
+#: is cheaper than HiGHS's import).
 ONE_SHOT_CANDIDATES = 64
 ONE_SHOT_NODES = 2_000
 ONE_SHOT_HIGHS = 1_000
@@ -39,6 +42,8 @@ def one_shot(problem: Any, relax: str | None) -> Any:
             return sol
     if problem.n_candidates > ONE_SHOT_HIGHS or not module_installed("highspy"):
         return None
+    if problem.ndim >= 3 and _interpreted(problem.n_candidates):
+        return None
     sol = solve(problem, "highs")
     if sol.status not in (Status.OPTIMAL, Status.INFEASIBLE):
         return None
@@ -48,3 +53,11 @@ def one_shot(problem: Any, relax: str | None) -> Any:
                    f"by HiGHS rather than {rather})")
     sol.info.update(requested="auto", one_shot=True)
     return sol
+
+
+def _interpreted(n_candidates: int) -> bool:
+    """Whether ``bnb``'s kernels would run as plain Python on a problem this size in
+    this process (nothing compiled yet, the default rule)."""
+    from ..solvers.kernels import tiers
+    return all(tiers.interpret(k, n_candidates, lambda: False)
+               for k in ("driver.solve", "batch.solve_batch"))
