@@ -508,6 +508,42 @@ def test_reproduction_same_numbers_with_two_workers(tmp_path):
     assert pick(one) == pick(two)
 
 
+def test_main_part_runs_a_method_once_when_its_best_is_the_printed_best():
+    from assocopt.reproduce import xue1999 as repro
+    tuned = {"did-printed": "did-printed@B=0.002,Mp=20",
+             "did-conflict-q0": "did-conflict-q0@B=0.002,Mp=20"}
+    exp = repro.experiments(2, 0, parts=("main",), tuned=tuned)[0]
+    assert len(exp.methods) == len(set(exp.methods))
+    assert "did-conflict-q0@B=0.002,Mp=20" in exp.methods
+
+
+def _verdict_summary(rates):
+    """A summary with main-part correct rates {method: (value, stderr)} and every
+    method but GNN tuned (best pair on the tuning seeds = the same value)."""
+    recs = [{"experiment": "main", "metric": "correct_rate", "method": m, "value": v,
+             "runs": 100, "stderr": se, "setting": {"noise_scale": 1.0, "clutter_mean": 10.0}}
+            for m, (v, se) in rates.items()]
+    tuned = {m.split("@")[0]: {"method": m, "correct_rate": v, "B": 0.02, "M_prime": 6.0,
+                               "range": [0.0, v]}
+             for m, (v, _) in rates.items() if m != "gnn"}
+    return {"records": recs, "tuned": tuned}
+
+
+def test_below_gnn_needs_the_95_percent_intervals_apart():
+    from assocopt.reproduce.xue1999.report import below_gnn, render_verdict
+    s = _verdict_summary({"gnn": (0.99, 0.002), "did-printed@B=0.02,Mp=6": (0.98, 0.002),
+                          "did-q0@B=0.02,Mp=6": (0.985, 0.002),
+                          "did-zm@B=0.02,Mp=6": (0.999, 0.001)})
+    # 0.98 + 1.96 (0.002 + 0.002) = 0.9878 < 0.99; 0.985 + 0.0078 > 0.99;
+    # 0.999 - 1.96 (0.001 + 0.002) = 0.9931 > 0.99
+    assert below_gnn(s) == {"did-printed": "below", "did-q0": "overlapping",
+                            "did-zm": "above"}
+    lines = render_verdict(s)
+    assert "1 of 3 below GNN, 1 of 3 not apart from GNN, 1 of 3 above GNN" in lines[0]
+    assert lines[-1].startswith("- best reading on the tuning seeds: DID, z-score error "
+                                "+ movable selection (ours), at B = 0.02, M′ = 6 (0.999)")
+
+
 def test_reproduction_rejects_unknown_options_and_methods():
     from assocopt.reproduce import xue1999 as repro
     with pytest.raises(ValueError, match="unknown xue1999 option"):
