@@ -146,9 +146,9 @@ def render_parameters(summary: Mapping[str, Any]) -> str:
          f"{tp['did_max_iter']} updates per record"),
         ("DID eq. 10 made defined", f"divide by max(abs(a_ij), floor_i), floors "
                                     f"{tp['did_origin_floor']} (x, y, vx, vy, IFF)"),
-        ("DID tuning (B x M')", f"B in {tu['B']} x M' in {tu['M_prime']}, "
+        ("DID tuning (B x M')", f"every pair of B in {tu['B']} x M' in {tu['M_prime']}, "
                                 f"{summary['tune_runs']} runs on seeds apart from the "
-                                f"reported ones; {', '.join(tu['methods'])}"),
+                                f"reported ones, for each of {', '.join(tu['methods'])}"),
         ("DID conflict rule (not from the paper)",
          "largest printed q keeps the track, the others are dropped (q_final); variants "
          "q_initial, new_track"),
@@ -244,7 +244,7 @@ def render_run(summary: Mapping[str, Any]) -> str:
              if f"xue1999-{p}" in t]
     return (f"- runs: {summary['runs']} of the base scene, {summary['tune_runs']} per point "
             f"of the tuning grid and {summary['sweep_runs']} per point of the sweep, seed {summary['seed']}\n"
-            f"- wall time of the full run: {summary['wall_s']:.0f} s with "
+            f"- wall time of the invocation that wrote this summary: {summary['wall_s']:.0f} s with "
             f"{summary['workers']} worker processes ({', '.join(parts)})")
 
 
