@@ -41,9 +41,10 @@ DEFAULTS: dict[str, Any] = {
     "noise_grid": (0.5, 1.0, 2.0, 3.0),
     "clutter_grid": (0.0, 10.0, 30.0),
     "sweep_divisor": 5,
-    "tune_methods": ("did-printed", "did-dowhile", "did-majority", "did-zm", "did-q0"),
-    "tune_B": (0.02, 0.05, 0.1, 0.2, 0.4),
-    "tune_M_prime": (2.0, 3.0, 4.0, 6.0, 10.0, 20.0, 40.0),
+    "tune_methods": tuple(m for m, o in METHODS.items() if o["rule"] == "did"),
+    "tune_B": (0.00002, 0.00005, 0.0001, 0.0002, 0.0005, 0.001, 0.002, 0.005, 0.01, 0.02,
+               0.05, 0.1, 0.2, 0.4),
+    "tune_M_prime": (1.0, 2.0, 3.0, 4.0, 6.0, 10.0, 20.0, 40.0),
     "tune_divisor": 5,
     "at_printed_best": ("did-printed-q0", "did-conflict-q0", "did-conflict-new"),
     "example_seed": 3,
@@ -174,6 +175,7 @@ def experiments(runs: int, seed: int, options: Mapping[str, Any] | None = None,
             best = split_method(tuned["did-printed"])[1]
             methods += tuple(tuned_name(m, best["did_B"], best["did_M_prime"])
                              for m in o["at_printed_best"])
+        methods = tuple(dict.fromkeys(methods))     # a method's own best may be printed's
         out.append(Experiment("xue1999-main", [{"part": "main", **base}], methods, trial,
                               runs, seed, params={"experiment": "main"}, volatile=VOLATILE))
     if "sweep" in parts:
