@@ -15,6 +15,11 @@ trial pairs, then the double-threshold rule over the steps).  The paper's readin
                      covariance in B; the reference headings' variance in B, our
                      substitute for the lost T_1); ``tsd-rect-c`` with all three;
                      ``tsd-rect-noself-c`` the same on the neighbour-pairs reading;
+    ``tsd-rect-global``, ``tsd-rect-noself-global`` both self-pair readings with
+                     trial pairs by a global 2-D assignment on Phi (ours: the paper's
+                     "smallest lambda" read row-wise is its own);
+    ``tsd-rect-t1``, ``tsd-rect-noself-t1`` both with our substitute for the lost
+                     heading threshold T_1 (``coef`` = C_1, 20 as the paper's);
     ``ted-rect``, ``ted-rect-noself`` the Euclidean baseline in the paper's reading.
 
 Our earlier reading, with a dummy per row and column at half the gate::
@@ -89,6 +94,12 @@ METHODS: dict[str, dict[str, Any]] = {
     "ted-rect": {"metric": "euclidean", "assignment": "rectangular"},
     "ted-rect-noself": {"metric": "euclidean", "assignment": "rectangular",
                         "self_pair": "exclude"},
+    "tsd-rect-global": {"assignment": "rectangular", "trial": "assignment"},
+    "tsd-rect-noself-global": {"assignment": "rectangular", "self_pair": "exclude",
+                               "trial": "assignment"},
+    "tsd-rect-t1": {"assignment": "rectangular", "threshold": "heading"},
+    "tsd-rect-noself-t1": {"assignment": "rectangular", "self_pair": "exclude",
+                           "threshold": "heading"},
     "tsd": {},
     "tsd-t1": {"threshold": "heading"},
     "tsd-full": {"frame": "full", "calibrate": True},
