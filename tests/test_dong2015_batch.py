@@ -1,7 +1,8 @@
 """Paper 004 (Dong et al. 2015): the batched rectangular reading
 (:mod:`assocopt.tracking.decide._topology_batch`, vectorised distances) gives the same
 Phi, confirmed counts and assignments as the plain compiled loop it replaced
-(``plain=True``), on random instances of several sizes and options."""
+(``plain=True``), on random instances of several sizes and options, also when each
+step's assignments are warm-started from the previous step's duals."""
 
 from __future__ import annotations
 
@@ -10,8 +11,8 @@ import zlib
 import numpy as np
 import pytest
 
-from assocopt.tracking.decide.topology import (TopologyParams, assign_pairs, phi_matrix,
-                                               prepare)
+from assocopt.tracking.decide.topology import (Duals, TopologyParams, assign_pairs,
+                                               phi_matrix, prepare)
 from assocopt.tracking.scenarios.dong2015 import Dong2015
 
 OPTIONS = [{}, {"self_pair": "exclude"}, {"metric": "euclidean"},
@@ -76,3 +77,31 @@ def test_not_positive_definite_gives_inf_in_both():
     phi, M = phi_matrix(inp, p)
     phi0, M0 = phi_matrix(inp, p, plain=True)
     assert (M == M0).all() and np.allclose(phi, phi0)
+
+
+@pytest.mark.parametrize("kw", [{}, {"self_pair": "exclude"}, {"inflate": True}],
+                         ids=lambda kw: ",".join(kw) or "default")
+@pytest.mark.parametrize("env", [1, 2, 3])
+def test_warm_started_steps_equal_the_plain_loop(kw, env):
+    """A whole run, every step warm-started from the last (as the experiment does)."""
+    run = Dong2015(env=env, n_targets=12, missed=2, false_tracks=2,
+                   n_steps=6).simulate(np.random.default_rng(env))
+    p = TopologyParams(assignment="rectangular", **kw)
+    d_phi, d_as = Duals(), Duals()
+    for st in run.steps:
+        inp = prepare(st.X1, st.P1, st.X2, st.P2, p)
+        phi, M = phi_matrix(inp, p, duals=d_phi)
+        phi0, M0 = phi_matrix(inp, p, plain=True)
+        assert (M == M0).all() and np.allclose(phi, phi0, rtol=1e-9)
+        cols, _ = assign_pairs(inp, p, duals=d_as)
+        assert (cols == assign_pairs(inp, p, plain=True)[0]).all()
+    assert d_phi.have.any() and d_as.have.any()
+
+
+def test_duals_restart_cold_when_the_shape_changes():
+    d = Duals()
+    V, have = d.arrays(3, 4)
+    have[:] = True
+    V2, have2 = d.arrays(4, 4)
+    assert V2.shape == (4, 4, 4) and not have2.any()
+    assert d.arrays(4, 4)[0] is V2

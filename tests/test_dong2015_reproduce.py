@@ -14,9 +14,9 @@ from conftest import check_page_against_summary
 ROOT = Path(__file__).resolve().parents[1]
 SMALL = {"n_targets": 10, "missed": 2, "false_tracks": 2, "n_steps": 3,
          "timing_n": (6,), "timing_steps": 2, "timing_runs": 1, "coef_grid": (0.0, 20.0),
-         "coef_divisor": 1, "main_methods": ("tsd-rect", "tsd-rect-noself", "tsd-rect-c", "tsd", "tsd-c", "ted",
-                          "gnn"),
-         "coef_methods": ("tsd-t1",), "timing_methods": ("tsd-c", "tsd-c-pregate")}
+         "coef_divisor": 1, "main_methods": ("tsd-rect", "tsd-rect-noself", "tsd-rect-global", "tsd-rect-c",
+                          "tsd", "tsd-c", "ted", "gnn"),
+         "coef_methods": ("tsd-t1", "tsd-rect-t1"), "timing_methods": ("tsd-c", "tsd-c-pregate")}
 
 
 def test_reproduction_writes_summary_figures_and_resumes(tmp_path):

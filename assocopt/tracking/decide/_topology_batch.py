@@ -20,7 +20,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from ...solvers.kernels.hungarian import hungarian
+from ...solvers.kernels.hungarian import hungarian, hungarian_warm
 from ...solvers.kernels.jit import njit
 
 INF = np.inf
@@ -117,10 +117,14 @@ def fill_exact(X1, Q1, X2, Q2, u, v, euclid, G):
 
 
 @njit(cache=True)
-def _solve_pair(X1, Q1, X2, Q2, u, v, euclid, t, exclude_ref, G, A, col):
+def _solve_pair(X1, Q1, X2, Q2, u, v, euclid, t, exclude_ref, G, A, col, V, have, warm):
     """The rectangular assignment of reference pair (u, v) into ``col`` (``-1``:
     none), ``G`` its exact distances; False when no entry is under the gate ``t``
-    (other than (u, v) when ``exclude_ref``): nothing can be confirmed then."""
+    (other than (u, v) when ``exclude_ref``): nothing can be confirmed then.
+
+    ``warm``: start the Hungarian from the column duals ``V[u, v]`` of this pair's
+    previous solve where ``have[u, v]`` (the previous step: the matrices change
+    little), and store this solve's duals there (speed only; same optimum)."""
     n1 = G.shape[0]
     n2 = G.shape[1]
     n = A.shape[0]
@@ -135,18 +139,25 @@ def _solve_pair(X1, Q1, X2, Q2, u, v, euclid, t, exclude_ref, G, A, col):
     for i in range(n):
         for j in range(n):
             A[i, j] = min(G[i, j], 1e300) if (i < n1 and j < n2) else 0.0
-    _, c, _, _, _ = hungarian(A)
+    if warm and have[u, v]:
+        _, c, _, vd, _ = hungarian_warm(A, V[u, v])
+    else:
+        _, c, _, vd, _ = hungarian(A)
+    if warm:
+        V[u, v, :] = vd
+        have[u, v] = True
     for i in range(n1):
         col[i] = c[i] if c[i] < n2 else -1
     return True
 
 
 @njit(cache=True)
-def rect_assign_kernel(X1, Q1, X2, Q2, euclid, thr, active):
+def rect_assign_kernel(X1, Q1, X2, Q2, euclid, thr, active, V, have, warm):
     """:func:`~._topology_kernel.assign_kernel` of the rectangular reading on the
     :func:`soa` arrays: ``(cols, gam)``, ``cols[u, v, i]`` the sensor-2 track assigned
     to neighbour i under (u, v) (``-1``: none, or the pair not solved) and
-    ``gam[u, v, i]`` its distance (``inf`` where ``cols`` is ``-1``)."""
+    ``gam[u, v, i]`` its distance (``inf`` where ``cols`` is ``-1``); ``V``, ``have``,
+    ``warm`` as in :func:`_solve_pair`."""
     n1 = X1.shape[2]
     n2 = X2.shape[2]
     out = np.full((n1, n2, n1), -1, np.int64)
@@ -158,7 +169,8 @@ def rect_assign_kernel(X1, Q1, X2, Q2, euclid, thr, active):
         for v in range(n2):
             if not active[u, v]:
                 continue
-            if not _solve_pair(X1, Q1, X2, Q2, u, v, euclid, thr[u, v], False, G, A, col):
+            if not _solve_pair(X1, Q1, X2, Q2, u, v, euclid, thr[u, v], False, G, A, col,
+                               V, have, warm):
                 continue
             for i in range(n1):
                 j = col[i]
@@ -170,9 +182,10 @@ def rect_assign_kernel(X1, Q1, X2, Q2, euclid, thr, active):
 
 @njit(cache=True)
 def rect_phi_kernel(X1, Q1, X2, Q2, euclid, thr, exclude_ref, min_pairs, active, large,
-                    objective):
+                    objective, V, have, warm):
     """:func:`~._topology_kernel.phi_kernel` of the rectangular reading on the
-    :func:`soa` arrays: ``(phi, M)``, lambda_uv and the confirmed-pair count."""
+    :func:`soa` arrays: ``(phi, M)``, lambda_uv and the confirmed-pair count
+    (``V``, ``have``, ``warm`` as in :func:`_solve_pair`)."""
     n1 = X1.shape[2]
     n2 = X2.shape[2]
     phi = np.full((n1, n2), large)
@@ -184,7 +197,8 @@ def rect_phi_kernel(X1, Q1, X2, Q2, euclid, thr, exclude_ref, min_pairs, active,
         for v in range(n2):
             t = thr[u, v]
             if not active[u, v] or not _solve_pair(X1, Q1, X2, Q2, u, v, euclid, t,
-                                                   exclude_ref, G, A, col):
+                                                   exclude_ref, G, A, col,
+                                                   V, have, warm):
                 continue
             s = 0.0
             m = 0

@@ -72,9 +72,9 @@ import numpy as np
 
 from ..decide.double_threshold import DoubleThreshold, IRRule
 from ..decide.nearest import gnn_assign, nearest_neighbour
-from ..decide.topology import (StepInputs, TopologyParams, assign_pairs, coarse_pregate,
-                               degree_matrix, phi_matrix, prepare, thresholds,
-                               trial_pairs)
+from ..decide.topology import (Duals, StepInputs, TopologyParams, assign_pairs,
+                               coarse_pregate, degree_matrix, phi_matrix, prepare,
+                               thresholds, trial_pairs)
 from ..costs.topology import chi2_gate, headings
 from .dong2015 import Run
 
@@ -172,6 +172,7 @@ def run_method(run: Run, method: str, setting: Mapping[str, Any] | None = None,
     p = None if "rule" in opts else _params(opts, setting)
     gate = chi2_gate(float(setting.get("alpha", 0.01)), 4)
     t_total, evaluated = 0.0, 0
+    duals = Duals()                        # warm start of the rectangular assignments
     for k, st in enumerate(run.steps, start=1):
         t0 = time.perf_counter()
         if opts.get("rule") == "nn":
@@ -190,7 +191,7 @@ def run_method(run: Run, method: str, setting: Mapping[str, Any] | None = None,
                 evaluated += n1 * n2
             if cache is None:
                 inp = prepare(st.X1, st.P1, st.X2, st.P2, p)
-                phi, _ = phi_matrix(inp, p, active)
+                phi, _ = phi_matrix(inp, p, active, duals=duals)
             else:
                 inp, phi, shared = _shared_phi(cache, k, st, p, active)
                 t0 -= shared
@@ -225,7 +226,8 @@ def _shared_phi(cache: dict, k: int, st, p: TopologyParams, active
     if key not in cache:
         t0 = time.perf_counter()
         inp = prepare(st.X1, st.P1, st.X2, st.P2, p)
-        cache[key] = (inp, *assign_pairs(inp, p, active), thresholds(inp, p))
+        duals = cache.setdefault(("duals",) + key[1:2], Duals())
+        cache[key] = (inp, *assign_pairs(inp, p, active, duals=duals), thresholds(inp, p))
         cache[key + ("s",)] = time.perf_counter() - t0
     else:
         took = cache[key + ("s",)]
