@@ -8,7 +8,8 @@ from typing import Any, Mapping
 from .._report import mean_ci, wall_time_line
 from .experiment import LABELS
 
-__all__ = ["lookup", "render_tables", "render_parameters", "render_headline", "steps_of"]
+__all__ = ["lookup", "render_tables", "render_parameters", "render_headline",
+           "render_comparison", "steps_of"]
 
 _FIG = {1: "Fig. 5", 2: "Fig. 6", 3: "Fig. 7"}
 
@@ -300,6 +301,36 @@ def render_parameters(summary: Mapping[str, Any]) -> str:
     ]
     return "\n".join(["| parameter | paper | ours |", "|---|---|---|"] +
                      [f"| {a} | {b} | {c} |" for a, b, c in rows])
+
+
+#: The two comparisons run on both readings: (row, paper's reading self pair in, self
+#: pair out, dummy reading).
+COMPARISON = (("none: row-wise trial pairs, chi-square gate (the paper's reading)",
+               "tsd-rect", "tsd-rect-noself", "tsd"),
+              ("global trial pairs (2-D assignment on Phi)", "tsd-rect-global",
+               "tsd-rect-noself-global", "tsd-global"),
+              ("T_1 stand-in, C_1 = {coef:g}", "tsd-rect-t1", "tsd-rect-noself-t1", "tsd-t1"))
+
+
+def render_comparison(summary: Mapping[str, Any]) -> str:
+    """E_c at the last step, environments 1 / 2 / 3, of the global trial pairs and the
+    T_1 stand-in on the paper's reading (self pair in and out) and on the dummy one."""
+    recs = summary["records"]
+    ks = steps_of(recs, "main")
+    if not ks:
+        return ""
+    ec = lookup(recs, "main", f"ec_k{ks[-1]:02d}")
+
+    def cell(m):
+        v = [_one(ec, m, e) for e in (1, 2, 3)]
+        return "—" if None in v else " / ".join(f"{x[0]:.2f}" for x in v)
+    L = [f"| comparison (each a change of ours), E_c at step {ks[-1]}, env 1 / 2 / 3 | "
+         "paper's reading, self pair in λ | paper's reading, neighbour pairs only | "
+         "dummy reading (ours) |", "|---|---|---|---|"]
+    coef = summary["parameters"]["ours"]["coef"]
+    L += [f"| {name.format(coef=coef)} | {cell(a)} | {cell(b)} | {cell(c)} |"
+          for name, a, b, c in COMPARISON]
+    return "\n".join(L)
 
 
 def render_headline(summary: Mapping[str, Any]) -> str:
