@@ -135,7 +135,7 @@ def _prose_fragments(summary) -> list[str]:
         f"{r['paper_noself_plain_mean_cpu_ms']:.1f} and {r['paper_noself_mean_cpu_ms']:.1f} ms "
         f"of cpu (wall {r['paper_noself_plain_mean_ms']:.1f} and "
         f"{r['paper_noself_mean_ms']:.1f} ms)",
-        f"load average {r['load']:.1f} to {r['load_end']:.1f}",
+        f"load average {r['load']:.1f} at the start and {r['load_end']:.1f} at the end, on the",
         f"takes {g(10):.0f} ms per step at 10 targets and {g(50) / 1e3:.1f} s at 50, "
         f"{g(50) / g(10):.0f} times as long",
         f"keeps {min(keep):.2f}–{max(keep):.2f} of the reference pairs",
