@@ -18,6 +18,10 @@ from assocopt.tracking.costs.topology import chi2_gate
 PINNED = {   # E_c at steps 1..6, in eighths (8 common targets)
     "tsd-rect": [5, 2, 4, 4, 3, 4],
     "tsd-rect-noself": [5, 1, 3, 3, 1, 3],
+    "tsd-rect-global": [4, 1, 3, 3, 3, 4],
+    "tsd-rect-noself-global": [3, 1, 2, 2, 1, 3],
+    "tsd-rect-t1": [2, 1, 3, 3, 5, 5],
+    "tsd-rect-noself-t1": [2, 1, 3, 3, 3, 4],
     "tsd-rect-obj": [5, 3, 4, 4, 5, 5],
     "tsd-rect-refcov": [0, 0, 0, 0, 0, 1],
     "tsd-rect-inflate": [1, 0, 0, 0, 0, 0],
@@ -55,6 +59,11 @@ def test_paper_readings_are_rectangular_and_differ_only_in_the_self_pair():
     for m in ("tsd-rect-obj", "tsd-rect-refcov", "tsd-rect-inflate"):
         changed = {k for k in METHODS[m] if k not in ("assignment", "calibrate")}
         assert len(changed) == 1, m                 # one change of ours at a time
+    for base in ("tsd-rect", "tsd-rect-noself"):  # global trial pairs, T_1 stand-in
+        for extra, change in (("-global", {"trial": "assignment"}),
+                              ("-t1", {"threshold": "heading"})):
+            assert METHODS[base + extra] == {
+                **{k: v for k, v in METHODS[base].items() if k != "calibrate"}, **change}
 
 
 def test_calibration_against_a_loop_over_true_pairs(small_run):

@@ -26,10 +26,12 @@ from .figures import make_figures
 
 #: Methods that are readings of the paper itself (the rest carry a change of ours).
 PAPER_READINGS = ("tsd-rect", "tsd-rect-noself", "ted-rect", "ted-rect-noself", "nn", "gnn")
-from .report import lookup, render_headline, render_parameters, render_tables  # noqa: F401
+from .report import (lookup, render_comparison, render_headline,  # noqa: F401
+                     render_parameters, render_tables)
 
 __all__ = ["DEFAULTS", "PAPER", "LABELS", "METHODS", "experiments", "trial", "parameters",
-           "run", "render_tables", "render_parameters", "render_headline", "make_figures",
+           "run", "render_tables", "render_parameters", "render_headline", "render_comparison",
+           "make_figures",
            "lap_paths"]
 
 

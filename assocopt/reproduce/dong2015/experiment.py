@@ -19,8 +19,8 @@ from typing import Any, Mapping, Sequence
 import numpy as np
 
 from ...experiments import Experiment
-from ...tracking.decide.topology import (TopologyParams, phi_matrix, phi_reference,
-                                         prepare)
+from ...tracking.decide.topology import (Duals, TopologyParams, assign_pairs,
+                                         phi_matrix, phi_reference, prepare)
 from ...tracking.scenarios.dong2015 import OURS as SCENARIO_OURS, Dong2015
 from ...tracking.scenarios.dong2015_assoc import METHODS, run_method
 from ...tracking.costs.topology import chi2_gate
@@ -38,11 +38,14 @@ DEFAULTS: dict[str, Any] = {
        for k, v in Dong2015().as_dict().items() if k in _SCENARIO},
     "n_targets": 30, "alpha": 0.01, "coef": 20.0, "euclid_gate_m": 1000.0,
     "ir_schedule": "dynamic", "ir_R_max": 4, "pregate_alpha": 0.01,
-    "main_methods": ("tsd-rect", "tsd-rect-noself", "tsd-rect-obj", "tsd-rect-refcov",
+    "main_methods": ("tsd-rect", "tsd-rect-noself", "tsd-rect-global",
+                     "tsd-rect-noself-global", "tsd-rect-t1", "tsd-rect-noself-t1",
+                     "tsd-rect-obj", "tsd-rect-refcov",
                      "tsd-rect-inflate", "tsd-rect-c", "tsd-rect-noself-c", "ted-rect",
-                     "ted-rect-noself", "tsd", "tsd-min5", "tsd-obj", "tsd-c",
-                     "tsd-c-global", "nn", "gnn"),
-    "coef_methods": ("tsd-t1", "ted-t1", "tsd-obj-t1", "ted-obj-t1"),
+                     "ted-rect-noself", "tsd", "tsd-t1", "tsd-global", "tsd-min5",
+                     "tsd-obj", "tsd-c", "tsd-c-global", "nn", "gnn"),
+    "coef_methods": ("tsd-rect-t1", "tsd-rect-noself-t1", "tsd-t1", "ted-t1",
+                     "tsd-obj-t1", "ted-obj-t1"),
     "coef_grid": (0.0, 5.0, 20.0, 50.0, 200.0),
     "coef_divisor": 2,
     "timing_n": (10, 20, 30, 50),
@@ -79,6 +82,10 @@ PAPER = {
 LABELS = {
     "tsd-rect": "TSD, paper's reading (assign, then gate; self pair in lambda)",
     "tsd-rect-noself": "TSD, paper's reading, neighbour pairs only (self pair out)",
+    "tsd-rect-global": "paper's reading, global trial pairs (ours: 2-D assignment on Phi)",
+    "tsd-rect-noself-global": "neighbour-pairs reading, global trial pairs (ours)",
+    "tsd-rect-t1": "paper's reading + T_1 substitute, C_1 = coef (ours)",
+    "tsd-rect-noself-t1": "neighbour-pairs reading + T_1 substitute (ours)",
     "tsd-rect-obj": "paper's reading + objective degree (ours)",
     "tsd-rect-refcov": "paper's reading + reference covariance (ours, modelling)",
     "tsd-rect-inflate": "paper's reading + heading variance (ours, T_1 substitute)",
@@ -86,7 +93,7 @@ LABELS = {
     "tsd-rect-noself-c": "neighbour-pairs reading + all three (ours)",
     "ted-rect": "TED, paper's reading (self pair in lambda)",
     "ted-rect-noself": "TED, paper's reading, neighbour pairs only",
-    "tsd": "TSD, dummy reading (ours)", "tsd-t1": "TSD dummy + T_1 substitute (ours)",
+    "tsd": "TSD, dummy reading (ours)", "tsd-t1": "TSD dummy + T_1 substitute, C_1 = coef (ours)",
     "tsd-full": "TSD dummy, full-state frame (ours)",
     "tsd-global": "TSD dummy, global trial pairs (ours)",
     "tsd-min5": "TSD dummy, lambda from >= 5 pairs (ours)",
@@ -125,12 +132,16 @@ def _scenario(s: Mapping[str, Any]) -> Dong2015:
 
 
 def _warm_up() -> None:
-    """Load the compiled kernel before anything is timed (a fresh worker process pays
-    the load once, which would otherwise land in its first trial's time)."""
+    """Load the compiled kernels before anything is timed (a fresh worker process pays
+    the load, or the compilation, once, which would otherwise land in its first
+    trial's time): both readings, Phi and the shared assignments, cold and warm-started."""
     X = np.array([[0.0, 0.0, 0.0, 100.0], [500.0, 0.0, 0.0, 100.0]])
     P = np.broadcast_to(np.eye(4) * 100.0, (2, 4, 4))
-    p = TopologyParams()
-    phi_matrix(prepare(X, P, X, P, p), p)
+    for p in (TopologyParams(), TopologyParams(assignment="rectangular")):
+        inp = prepare(X, P, X, P, p)
+        for duals in (None, Duals()):
+            phi_matrix(inp, p, duals=duals)
+            assign_pairs(inp, p, duals=duals)
 
 
 def trial(setting: Mapping[str, Any], methods: Sequence[str],
@@ -168,8 +179,12 @@ def experiments(runs: int, seed: int, options: Mapping[str, Any] | None = None,
 
 
 #: Readings timed per step by :func:`lap_paths`: (key, TopologyParams options).
+#: ``*_plain``: the same reading by the scalar loop the batched kernel replaced (before).
 LAP_READINGS = (("paper", {"assignment": "rectangular"}),
+                ("paper_plain", {"assignment": "rectangular", "plain": True}),
                 ("paper_noself", {"assignment": "rectangular", "self_pair": "exclude"}),
+                ("paper_noself_plain", {"assignment": "rectangular", "self_pair": "exclude",
+                                        "plain": True}),
                 ("rect_c", {"assignment": "rectangular", "degree": "objective",
                             "inflate": True, "ref_cov": True}),
                 ("compiled", {"degree": "objective", "inflate": True, "ref_cov": True}))
@@ -187,15 +202,21 @@ def lap_paths(seed: int = 0, sizes: Sequence[int] = (10, 30, 50), repeat: int = 
         run = Dong2015(env=2, n_targets=int(n)).simulate(np.random.default_rng(seed))
         row: dict[str, Any] = {"n_targets": int(n), "load": os.getloadavg()[0]}
         for name, kw in LAP_READINGS:
+            kw = dict(kw)
+            plain = kw.pop("plain", False)
             p = TopologyParams(**kw)
             for where, st in (("first", run.steps[0]), ("last", run.steps[-1])):
                 inp = prepare(st.X1, st.P1, st.X2, st.P2, p)
-                phi_matrix(inp, p)                                  # compile / warm up
+                phi_matrix(inp, p, plain=plain)                     # compile / warm up
                 t0 = time.perf_counter()
                 for _ in range(repeat):
-                    phi, M = phi_matrix(prepare(st.X1, st.P1, st.X2, st.P2, p), p)
+                    phi, M = phi_matrix(prepare(st.X1, st.P1, st.X2, st.P2, p), p,
+                                        plain=plain)
                 key = f"{name}_ms" if where == "last" else f"{name}_first_ms"
                 row[key] = 1e3 * (time.perf_counter() - t0) / repeat
+            if name.startswith("paper"):
+                row[f"{name}_mean_ms"], row[f"{name}_mean_cpu_ms"] = _mean_step_ms(run, p,
+                                                                                  plain)
             if name == "compiled" and n <= 30:
                 t0 = time.perf_counter()
                 ref, M_ref = phi_reference(inp, p)
@@ -205,6 +226,19 @@ def lap_paths(seed: int = 0, sizes: Sequence[int] = (10, 30, 50), repeat: int = 
         row["load_end"] = os.getloadavg()[0]
         out.append(row)
     return out
+
+
+def _mean_step_ms(run, p: TopologyParams, plain: bool) -> tuple[float, float]:
+    """One step's Phi (inputs prepared included), averaged over every step of ``run``,
+    each step's assignments warm-started from the previous step's (as in the
+    experiment) except by the plain loop: ``(wall ms, CPU ms of this process)`` (on a
+    shared machine the load inflates the wall time, much less the CPU time)."""
+    duals = None if plain else Duals()
+    t0, c0 = time.perf_counter(), time.process_time()
+    for st in run.steps:
+        phi_matrix(prepare(st.X1, st.P1, st.X2, st.P2, p), p, plain=plain, duals=duals)
+    K = len(run.steps)
+    return 1e3 * (time.perf_counter() - t0) / K, 1e3 * (time.process_time() - c0) / K
 
 
 def _assignment_only(inp, p: TopologyParams) -> dict[str, float]:

@@ -8,7 +8,8 @@ from typing import Any, Mapping
 from .._report import mean_ci, wall_time_line
 from .experiment import LABELS
 
-__all__ = ["lookup", "render_tables", "render_parameters", "render_headline", "steps_of"]
+__all__ = ["lookup", "render_tables", "render_parameters", "render_headline",
+           "render_comparison", "steps_of"]
 
 _FIG = {1: "Fig. 5", 2: "Fig. 6", 3: "Fig. 7"}
 
@@ -165,8 +166,9 @@ def _coef_table(recs) -> list[str]:
     tabs = {k: lookup(recs, "coef", f"ec_k{k:02d}") for k in ks}
     runs = max(v[1] for v in tabs[ks[0]].values())
     coefs = sorted({key[2] for key in tabs[ks[0]]})
-    L = [f"### Threshold coefficient (Figs. 3-4; our substitute for T_1, on the dummy "
-         f"reading), environment 2: E_c per step ({runs} runs per point)", "",
+    L = [f"### Threshold coefficient (Figs. 3-4; our substitute for T_1, on the paper's "
+         f"reading and on the dummy reading), environment 2: E_c per step ({runs} runs "
+         "per point)", "",
          "| method | coefficient | " + " | ".join(f"k={k}" for k in ks) + " |",
          "|---|---|" + "---|" * len(ks)]
     for m in _methods(tabs[ks[0]]):
@@ -216,11 +218,14 @@ def _timing_tables(summary) -> list[str]:
         L.append("")
     lp = summary.get("lap_paths")
     if lp:
-        names = [("paper", "paper's reading"), ("paper_noself", "neighbour pairs only"),
+        names = [("paper", "paper's reading"), ("paper_plain", "paper's reading, before"),
+                 ("paper_noself", "neighbour pairs only"),
+                 ("paper_noself_plain", "neighbour pairs only, before"),
                  ("rect_c", "paper's reading + all three"),
                  ("compiled", "dummy reading + all three")]
         L += ["### One step's Phi at n targets a side: the compiled loop for each reading "
-              "(ms, environment 2, first step / last step), against `assocopt.solve` one "
+              "(ms, environment 2, first step / last step; *before*: the scalar loop the "
+              "batched kernel replaced), against `assocopt.solve` one "
               "pair at a time (dummy reading + all three, last step)", "",
               "| targets | load avg | " + " | ".join(t for _, t in names)
               + " | through solve | of which the assignments in solve | the same "
@@ -234,6 +239,19 @@ def _timing_tables(summary) -> list[str]:
                      + f" | {f('solve_ms')} | {f('solve_only_ms')} | {f('lsa_only_ms')} | "
                      f"{agree} |")
         L.append("")
+        mean = [(k, t) for k, t in names if any(f"{k}_mean_ms" in r for r in lp)]
+        if mean:
+            L += ["### One step of the paper's reading, averaged over the 12 steps of one "
+                  "run (ms, environment 2; inputs prepared included; wall / CPU time of the "
+                  "process; *before*: the scalar loop; otherwise batched, each step "
+                  "warm-started from the previous one)", "",
+                  "| targets | load avg | " + " | ".join(t for _, t in mean) + " |",
+                  "|---|---|" + "---|" * len(mean)]
+            for r in lp:
+                L.append(f"| {r['n_targets']} | {r['load']:.1f}–{r['load_end']:.1f} | "
+                         + " | ".join(f"{r[k + '_mean_ms']:.1f} / {r[k + '_mean_cpu_ms']:.1f}"
+                                      for k, _ in mean) + " |")
+            L.append("")
     return L
 
 
@@ -285,6 +303,36 @@ def render_parameters(summary: Mapping[str, Any]) -> str:
                      [f"| {a} | {b} | {c} |" for a, b, c in rows])
 
 
+#: The two comparisons run on both readings: (row, paper's reading self pair in, self
+#: pair out, dummy reading).
+COMPARISON = (("none: row-wise trial pairs, chi-square gate (the paper's reading)",
+               "tsd-rect", "tsd-rect-noself", "tsd"),
+              ("global trial pairs (2-D assignment on Phi)", "tsd-rect-global",
+               "tsd-rect-noself-global", "tsd-global"),
+              ("T_1 stand-in, C_1 = {coef:g}", "tsd-rect-t1", "tsd-rect-noself-t1", "tsd-t1"))
+
+
+def render_comparison(summary: Mapping[str, Any]) -> str:
+    """E_c at the last step, environments 1 / 2 / 3, of the global trial pairs and the
+    T_1 stand-in on the paper's reading (self pair in and out) and on the dummy one."""
+    recs = summary["records"]
+    ks = steps_of(recs, "main")
+    if not ks:
+        return ""
+    ec = lookup(recs, "main", f"ec_k{ks[-1]:02d}")
+
+    def cell(m):
+        v = [_one(ec, m, e) for e in (1, 2, 3)]
+        return "—" if None in v else " / ".join(f"{x[0]:.2f}" for x in v)
+    L = [f"| comparison (each a change of ours), E_c at step {ks[-1]}, env 1 / 2 / 3 | "
+         "paper's reading, self pair in λ | paper's reading, neighbour pairs only | "
+         "dummy reading (ours) |", "|---|---|---|---|"]
+    coef = summary["parameters"]["ours"]["coef"]
+    L += [f"| {name.format(coef=coef)} | {cell(a)} | {cell(b)} | {cell(c)} |"
+          for name, a, b, c in COMPARISON]
+    return "\n".join(L)
+
+
 def render_headline(summary: Mapping[str, Any]) -> str:
     """The key numbers quoted in the page's text: the paper's reading first."""
     recs = summary["records"]
@@ -293,8 +341,10 @@ def render_headline(summary: Mapping[str, Any]) -> str:
     ec = lookup(recs, "main", f"ec_k{last:02d}")
     mean = lookup(recs, "main", "ec_mean")
     L = []
-    for m in ("tsd-rect", "tsd-rect-noself", "ted-rect", "ted-rect-noself", "tsd-rect-obj",
-              "tsd-rect-refcov", "tsd-rect-inflate", "tsd-rect-c", "tsd", "tsd-c", "gnn"):
+    for m in ("tsd-rect", "tsd-rect-noself", "ted-rect", "ted-rect-noself",
+              "tsd-rect-global", "tsd-rect-noself-global", "tsd-rect-t1",
+              "tsd-rect-noself-t1", "tsd-rect-obj", "tsd-rect-refcov", "tsd-rect-inflate",
+              "tsd-rect-c", "tsd", "tsd-global", "tsd-t1", "tsd-c", "tsd-c-global", "gnn"):
         cells = [f"env {e}: {_ci(_one(ec, m, e))} (mean over steps {_ci(_one(mean, m, e))})"
                  for e in (1, 2, 3) if _one(ec, m, e) is not None]
         if cells:
@@ -320,7 +370,7 @@ def render_headline(summary: Mapping[str, Any]) -> str:
                  f"{_ci(_one(hd, 'tsd', 2), 3)} rad, sensor 2 {_ci(_one(hd2, 'tsd', 2), 3)} rad")
     t = lookup(recs, "main", "t_step_ms")
     cells = [f"{LABELS[m]} {_ci(_one(t, m, 2), 1)} ms"
-             for m in ("tsd-rect", "tsd-rect-noself", "tsd-rect-c", "tsd-c")
+             for m in ("tsd-rect", "tsd-rect-noself", "tsd-rect-t1", "tsd-rect-c", "tsd-c")
              if _one(t, m, 2) is not None]
     if cells:
         ld = summary.get("load")
@@ -333,7 +383,14 @@ def render_headline(summary: Mapping[str, Any]) -> str:
                  f"{r['paper_first_ms']:.1f} / {r['paper_ms']:.1f} ms, neighbour pairs only "
                  f"{r['paper_noself_first_ms']:.1f} / {r['paper_noself_ms']:.1f} ms, dummy "
                  f"reading + all three {r['compiled_first_ms']:.1f} / {r['compiled_ms']:.1f} "
-                 f"ms (load average {r['load']:.1f}); "
+                 f"ms; before (the scalar loop): paper's reading {r['paper_plain_first_ms']:.1f}"
+                 f" / {r['paper_plain_ms']:.1f} ms; mean over the 12 steps (wall / CPU): "
+                 f"paper's reading {r['paper_mean_ms']:.1f} / {r['paper_mean_cpu_ms']:.1f} ms "
+                 f"(before {r['paper_plain_mean_ms']:.1f} / "
+                 f"{r['paper_plain_mean_cpu_ms']:.1f}), neighbour pairs only "
+                 f"{r['paper_noself_mean_ms']:.1f} / {r['paper_noself_mean_cpu_ms']:.1f} ms "
+                 f"(before {r['paper_noself_plain_mean_ms']:.1f} / "
+                 f"{r['paper_noself_plain_mean_cpu_ms']:.1f}) (load average {r['load']:.1f}); "
                  f"{r.get('solve_ms', float('nan')):.0f} ms through `assocopt.solve`")
     if "wall_s" in summary:
         L.append(f"- wall time of the full run: {summary['wall_s']:.0f} s with "

@@ -59,7 +59,7 @@ from ...problems.problem import AssignmentProblem
 from ..costs.topology import (check_tracks, chi2_gate, heading_jacobians, heading_variance,
                         pair_distances, reference_frames)
 
-__all__ = ["TopologyParams", "StepInputs", "prepare", "thresholds", "pair_gammas",
+__all__ = ["TopologyParams", "StepInputs", "Duals", "prepare", "thresholds", "pair_gammas",
            "phi_matrix", "phi_reference", "assign_pairs", "degree_matrix",
            "coarse_pregate", "trial_pairs", "LARGE"]
 
@@ -159,33 +159,77 @@ def _kernel_args(inp: StepInputs, params: TopologyParams, active):
             params.assignment == "dummy"), act
 
 
+@dataclass
+class Duals:
+    """Column duals of every reference pair's last rectangular assignment, kept from
+    one step to the next as the Hungarian's warm start (the same tracks in the same
+    order; a change of shape starts cold).  Speed only: the optimum is the same."""
+
+    V: np.ndarray | None = None
+    have: np.ndarray | None = None
+
+    def arrays(self, n1: int, n2: int) -> tuple[np.ndarray, np.ndarray]:
+        n = max(n1, n2)
+        if self.V is None or self.V.shape != (n1, n2, n):
+            self.V, self.have = np.zeros((n1, n2, n)), np.zeros((n1, n2), bool)
+        return self.V, self.have
+
+
+def _warm(duals: Duals | None, n1: int, n2: int) -> tuple[np.ndarray, np.ndarray, bool]:
+    if duals is None:
+        return np.zeros((0, 0, 0)), np.zeros((0, 0), bool), False
+    return (*duals.arrays(n1, n2), True)
+
+
+def _batch_args(args):
+    """The :mod:`._topology_batch` arrays from :func:`_kernel_args`' tuple."""
+    from ._topology_batch import soa
+    X1r, P1r, X2r, P2r, J1, v1, J2, v2, inflate, euclid, thr, _ = args
+    return (*soa(X1r, P1r, J1, v1, inflate), *soa(X2r, P2r, J2, v2, inflate), euclid, thr)
+
+
 def phi_matrix(inp: StepInputs, params: TopologyParams,
-               active: np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray]:
+               active: np.ndarray | None = None, *, plain: bool = False,
+               duals: Duals | None = None) -> tuple[np.ndarray, np.ndarray]:
     """``(Phi, M)``: lambda_uv and the confirmed-pair count of every reference pair
-    (compiled; ``active`` False skips a pair, e.g. after :func:`coarse_pregate`)."""
+    (compiled; ``active`` False skips a pair, e.g. after :func:`coarse_pregate`).
+    The rectangular reading runs on :mod:`._topology_batch` (vectorised distances)
+    unless ``plain``, which keeps the scalar loop of :mod:`._topology_kernel` (the
+    same answers; kept for the check and for timing before / after); ``duals``
+    (rectangular, not ``plain``): warm-start the assignments from the previous step's
+    (:class:`Duals`, updated in place)."""
     from ._topology_kernel import phi_kernel
     n1, n2 = inp.X1r.shape[1], inp.X2r.shape[1]
     if n1 == 0 or n2 == 0:
         return np.full((n1, n2), LARGE), np.zeros((n1, n2), np.int64)
     args, act = _kernel_args(inp, params, active)
+    if params.assignment == "rectangular" and not plain:
+        from ._topology_batch import rect_phi_kernel
+        return rect_phi_kernel(*_batch_args(args), params.self_pair == "exclude",
+                               params.min_pairs, act, LARGE, params.degree == "objective",
+                               *_warm(duals, n1, n2))
     return phi_kernel(*args, params.self_pair == "exclude", params.min_pairs, act, LARGE,
                       params.degree == "objective")
 
 
 def assign_pairs(inp: StepInputs, params: TopologyParams,
-                 active: np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray]:
+                 active: np.ndarray | None = None, *, plain: bool = False,
+                 duals: Duals | None = None) -> tuple[np.ndarray, np.ndarray]:
     """Every reference pair's assignment, before any degree is formed: ``(cols,
     gam)``, ``cols[u, v, i]`` the sensor-2 track assigned to neighbour i under (u, v)
     (``-1``: none, or nothing under the gate) and ``gam[u, v, i]`` its distance.
     :func:`degree_matrix` turns them into Phi for any ``self_pair``, ``degree`` and
     ``min_pairs`` (which do not change the assignment), so several readings can share
     one solve; ``degree_matrix(*assign_pairs(inp, p), thresholds(inp, p), p)`` equals
-    ``phi_matrix(inp, p)``."""
+    ``phi_matrix(inp, p)``; ``plain`` and ``duals`` as in :func:`phi_matrix`."""
     from ._topology_kernel import assign_kernel
     n1, n2 = inp.X1r.shape[1], inp.X2r.shape[1]
     if n1 == 0 or n2 == 0:
         return np.full((n1, n2, n1), -1, np.int64), np.full((n1, n2, n1), np.inf)
     args, act = _kernel_args(inp, params, active)
+    if params.assignment == "rectangular" and not plain:
+        from ._topology_batch import rect_assign_kernel
+        return rect_assign_kernel(*_batch_args(args), act, *_warm(duals, n1, n2))
     return assign_kernel(*args, act)
 
 

@@ -15,6 +15,11 @@ trial pairs, then the double-threshold rule over the steps).  The paper's readin
                      covariance in B; the reference headings' variance in B, our
                      substitute for the lost T_1); ``tsd-rect-c`` with all three;
                      ``tsd-rect-noself-c`` the same on the neighbour-pairs reading;
+    ``tsd-rect-global``, ``tsd-rect-noself-global`` both self-pair readings with
+                     trial pairs by a global 2-D assignment on Phi (ours: the paper's
+                     "smallest lambda" read row-wise is its own);
+    ``tsd-rect-t1``, ``tsd-rect-noself-t1`` both with our substitute for the lost
+                     heading threshold T_1 (``coef`` = C_1, 20 as the paper's);
     ``ted-rect``, ``ted-rect-noself`` the Euclidean baseline in the paper's reading.
 
 Our earlier reading, with a dummy per row and column at half the gate::
@@ -67,9 +72,9 @@ import numpy as np
 
 from ..decide.double_threshold import DoubleThreshold, IRRule
 from ..decide.nearest import gnn_assign, nearest_neighbour
-from ..decide.topology import (StepInputs, TopologyParams, assign_pairs, coarse_pregate,
-                               degree_matrix, phi_matrix, prepare, thresholds,
-                               trial_pairs)
+from ..decide.topology import (Duals, StepInputs, TopologyParams, assign_pairs,
+                               coarse_pregate, degree_matrix, phi_matrix, prepare,
+                               thresholds, trial_pairs)
 from ..costs.topology import chi2_gate, headings
 from .dong2015 import Run
 
@@ -89,6 +94,12 @@ METHODS: dict[str, dict[str, Any]] = {
     "ted-rect": {"metric": "euclidean", "assignment": "rectangular"},
     "ted-rect-noself": {"metric": "euclidean", "assignment": "rectangular",
                         "self_pair": "exclude"},
+    "tsd-rect-global": {"assignment": "rectangular", "trial": "assignment"},
+    "tsd-rect-noself-global": {"assignment": "rectangular", "self_pair": "exclude",
+                               "trial": "assignment"},
+    "tsd-rect-t1": {"assignment": "rectangular", "threshold": "heading"},
+    "tsd-rect-noself-t1": {"assignment": "rectangular", "self_pair": "exclude",
+                           "threshold": "heading"},
     "tsd": {},
     "tsd-t1": {"threshold": "heading"},
     "tsd-full": {"frame": "full", "calibrate": True},
@@ -161,6 +172,7 @@ def run_method(run: Run, method: str, setting: Mapping[str, Any] | None = None,
     p = None if "rule" in opts else _params(opts, setting)
     gate = chi2_gate(float(setting.get("alpha", 0.01)), 4)
     t_total, evaluated = 0.0, 0
+    duals = Duals()                        # warm start of the rectangular assignments
     for k, st in enumerate(run.steps, start=1):
         t0 = time.perf_counter()
         if opts.get("rule") == "nn":
@@ -179,7 +191,7 @@ def run_method(run: Run, method: str, setting: Mapping[str, Any] | None = None,
                 evaluated += n1 * n2
             if cache is None:
                 inp = prepare(st.X1, st.P1, st.X2, st.P2, p)
-                phi, _ = phi_matrix(inp, p, active)
+                phi, _ = phi_matrix(inp, p, active, duals=duals)
             else:
                 inp, phi, shared = _shared_phi(cache, k, st, p, active)
                 t0 -= shared
@@ -214,7 +226,8 @@ def _shared_phi(cache: dict, k: int, st, p: TopologyParams, active
     if key not in cache:
         t0 = time.perf_counter()
         inp = prepare(st.X1, st.P1, st.X2, st.P2, p)
-        cache[key] = (inp, *assign_pairs(inp, p, active), thresholds(inp, p))
+        duals = cache.setdefault(("duals",) + key[1:2], Duals())
+        cache[key] = (inp, *assign_pairs(inp, p, active, duals=duals), thresholds(inp, p))
         cache[key + ("s",)] = time.perf_counter() - t0
     else:
         took = cache[key + ("s",)]
