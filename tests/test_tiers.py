@@ -91,7 +91,10 @@ def test_a_search_past_its_budget_is_solved_again_compiled(fresh, monkeypatch):
 
     def recorded(fn, args, stop, **kw):
         out = real(fn, args, stop, **kw)
-        calls.append((getattr(fn, "interpreted", False), out[1]))
+        plain = getattr(fn, "interpreted", False)
+        if plain:                      # as if the budget's clock had stopped it: a
+            out = (out[0], True)       # tiny problem may end before looking at it
+        calls.append((plain, out[1]))
         return out
     monkeypatch.setattr(intr, "run_stoppable", recorded)
     got = solve(p, "bnb")
