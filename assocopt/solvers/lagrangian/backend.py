@@ -24,9 +24,10 @@ from .local_search import _LocalSearch
 from .options import OPTIONS, OPTIONS_EXACT, check_engines
 from .reduction import dominated
 from .relaxation import _Relaxation
-from .window import (_COMPILED_NODES, _CPSAT_BUDGET, _CPSAT_MAX, _PROBE_SEARCH_MAX,
-                     _SEARCH_MAX, _SEARCH_NODES, _compiled_search, _cover_search, _cpsat,
-                     Outcome, _grow, _has_numba, _has_ortools, _ilp, _uncovered)
+from .window import (_COMPILED_NODES, _CPSAT_BUDGET, _CPSAT_MAX, _OPEN_NODES,
+                     _PROBE_SEARCH_MAX, _SEARCH_MAX, _SEARCH_NODES, _Skipper,
+                     _compiled_search, _cover_search, _cpsat, Outcome, _grow, _has_numba,
+                     _has_ortools, _ilp, _uncovered)
 
 #: The exact mode runs the local search only above this many candidates.
 _LS_MIN_K = 2000
@@ -40,7 +41,6 @@ class _LagrangianBase(Backend):
     gives_bound = True
     supports_time_limit = True
     _exact: bool = False
-
     own_method = True
 
     def solve(self, problem: AssignmentProblem, options: SolveOptions) -> RawResult:
@@ -101,7 +101,6 @@ class _LagrangianBase(Backend):
                                 f"problem on axes {keep} has no assignment ({exc})")
         times["ascent"] = time.perf_counter() - t0
         info["ascent_stop"] = st.stop
-
         if self._exact and st.stop not in ("proven", "time_limit", "gap_tol"):
             self._close_gap(problem, rel, pos, upad, st, p, options, deadline, info, times)
 
@@ -186,6 +185,7 @@ class _LagrangianBase(Backend):
         windows: list[dict[str, Any]] = []
         info["windows"] = windows
         budget = 2 * problem.n_rows
+        skip = _Skipper()
         while True:
             st.bound = max(st.bound, min(lo, st.ub))
             if st.incumbent is not None and st.closes(st.bound):
@@ -205,6 +205,7 @@ class _LagrangianBase(Backend):
             T = lo + 1.0 if st.integer else lo + st.tol()
             if int(np.searchsorted(lb, T, "left")) < budget and K:
                 T = max(T, float(lb[min(budget, K - 1)]))
+            T = skip.threshold(T, st.integer, st.ub)
             final = T >= st.ub
             if final:
                 T = st.ub
@@ -231,9 +232,14 @@ class _LagrangianBase(Backend):
                 budget = max(budget, _grow(n_in, st.integer))
                 continue
             cap = st.ub if closed else T          # only solutions below cap matter
+            leave = skip.may_skip(closed, st.integer, lb, n_in, T)
             status, z, how = self._window(problem, win, red_of, base, lo, cap, closed,
-                                          st, p, options, deadline, rec)
+                                          st, p, options, deadline, rec, leave)
             rec["result"], rec["solver"] = status.value, how
+            if status is Outcome.GAVE_UP:     # a larger window holds this one
+                skip.gave_up(T)
+                budget = max(budget, _grow(n_in, st.integer))
+                continue
             if status is Outcome.AT_BOUND or (status is Outcome.OPTIMAL and
                                               (closed or (z is not None and z < cap))):
                 if st.incumbent is None:
@@ -265,8 +271,8 @@ class _LagrangianBase(Backend):
     @staticmethod
     def _window(problem: AssignmentProblem, win: np.ndarray, red_of: np.ndarray, base: float,
                 lo: float, cap: float, closed: bool, st: _State, p: dict[str, Any],
-                options: SolveOptions, deadline: float | None, rec: dict[str, Any]
-                ) -> tuple[Outcome, float | None, str]:
+                options: SolveOptions, deadline: float | None, rec: dict[str, Any],
+                skip: bool = False) -> tuple[Outcome, float | None, str]:
         """Best solution among the candidates ``win`` costing less than ``cap``.
 
         Returns ``(outcome, objective, engine)``, the outcome in the engines' common
@@ -275,8 +281,9 @@ class _LagrangianBase(Backend):
         """
         if _has_numba() or len(win) <= _SEARCH_MAX:
             if _has_numba():
+                nodes = _OPEN_NODES if skip else _COMPILED_NODES
                 sel, complete = _compiled_search(problem, win, red_of[win], base, cap,
-                                                 st.integer, _COMPILED_NODES)
+                                                 st.integer, nodes)
                 how = "compiled search"
             else:
                 sel, complete = _cover_search(problem, win, red_of[win], base, cap,
@@ -287,6 +294,8 @@ class _LagrangianBase(Backend):
                     return Outcome.NONE_BELOW, None, how
                 st.offer(sel)
                 return Outcome.OPTIMAL, math.fsum(problem.costs[sel].tolist()), how
+            if skip:                      # a larger window decides (see _Skipper)
+                return Outcome.GAVE_UP, None, how
         start = closed and st.incumbent is not None
         use_cp = st.integer and (p["window_solver"] == "cpsat" or (
             p["window_solver"] == "auto" and len(win) <= _CPSAT_MAX and _has_ortools()))
