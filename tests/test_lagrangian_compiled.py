@@ -116,3 +116,36 @@ def test_skipper_goes_back_to_the_first_window():
     assert s.threshold(12.0, True, 50.0) == 10.0           # back to the first
     assert not s.may_skip(False, True, lb, 10, 10.0)
     assert s.threshold(11.0, True, 50.0) == 11.0
+
+
+@pytest.mark.parametrize("seed", range(4))
+def test_windows_solved_by_components_equal_highs(seed):
+    """Gated scans closer than the gate (one component), a short ascent so that the
+    windows are large: the windows split and are solved component by component
+    (the path was taken), with HiGHS's optimum."""
+    from benchmarks.tracking_scans import ScanSpec, build_problem
+    from assocopt.solvers.lagrangian import window as lw
+    p, _ = build_problem(ScanSpec(N=4, n=30, spacing=0.8, seed=seed))
+    with pytest.MonkeyPatch.context() as mp:
+        mp.setattr(lw, "_SPLIT_MIN", 2)
+        mp.setattr("assocopt.solvers.lagrangian.backend._SPLIT_MIN", 2)
+        sol = solve(p, "lagrangian-exact", max_iter=4, decompose=False, local_search=False)
+    assert_optimal(p, sol, reference=solve(p, "highs").objective)
+    engines = {w.get("solver") for w in sol.info.get("windows", [])}
+    assert "components" in engines, sol.info.get("windows")
+
+
+def test_connected_or_nested_windows_are_left_to_the_engines():
+    from assocopt.solvers.lagrangian import window as lw
+    from assocopt.solvers.lagrangian.ascent import _State
+    p = AssignmentProblem.dense(np.arange(27.0).reshape(3, 3, 3))   # one component
+    st = _State(costs=p.costs, integer=True)
+    from assocopt.solvers.base import SolveOptions
+    assert lw._by_components(p, np.arange(27), st, SolveOptions(), None) is None
+    token = lw._NESTED.set(True)
+    try:
+        q = AssignmentProblem.sparse((2, 2, 2), [[1, 1, 1], [2, 2, 2]], [1.0, 2.0])
+        assert lw._by_components(q, np.arange(2), _State(costs=q.costs, integer=True),
+                                 SolveOptions(), None) is None
+    finally:
+        lw._NESTED.reset(token)

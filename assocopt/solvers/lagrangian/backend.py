@@ -25,9 +25,9 @@ from .options import OPTIONS, OPTIONS_EXACT, check_engines
 from .reduction import dominated
 from .relaxation import _Relaxation
 from .window import (_COMPILED_NODES, _CPSAT_BUDGET, _CPSAT_MAX, _OPEN_NODES,
-                     _PROBE_SEARCH_MAX, _SEARCH_MAX, _SEARCH_NODES, _Skipper,
-                     _compiled_search, _cover_search, _cpsat, Outcome, _grow, _has_numba,
-                     _has_ortools, _ilp, _uncovered)
+                     _PROBE_SEARCH_MAX, _SEARCH_MAX, _SEARCH_NODES, _SPLIT_MIN, _Skipper,
+                     _by_components, _compiled_search, _cover_search, _cpsat, Outcome,
+                     _grow, _has_numba, _has_ortools, _ilp, _uncovered)
 
 #: The exact mode runs the local search only above this many candidates.
 _LS_MIN_K = 2000
@@ -103,7 +103,6 @@ class _LagrangianBase(Backend):
         info["ascent_stop"] = st.stop
         if self._exact and st.stop not in ("proven", "time_limit", "gap_tol"):
             self._close_gap(problem, rel, pos, upad, st, p, options, deadline, info, times)
-
         if st.incumbent is None and problem.n_candidates <= 200_000 and \
                 (deadline is None or time.perf_counter() < deadline):
             from ..baseline.greedy import greedy_select
@@ -166,7 +165,8 @@ class _LagrangianBase(Backend):
         window costs less than ``T`` it is optimal, and if none does, ``T`` is a new
         lower bound.  Windows grow (by candidate count) until ``T`` reaches the
         incumbent, whose window (with the incumbent added) is the classic fixing
-        step.  Each window goes to the cover search, CP-SAT or HiGHS (see ``window``).
+        step.  Each window goes to its components (when it splits), the cover search,
+        CP-SAT or HiGHS (see ``window``).
         """
         t0 = time.perf_counter()
         lb, red, base = rel.fixing_bounds(upad)
@@ -175,11 +175,9 @@ class _LagrangianBase(Backend):
         red_of[gpos] = red
         order = np.argsort(lb, kind="stable")
         lb, gpos = lb[order], gpos[order]
-        if st.integer:
-            lb = np.ceil(lb - 1e-6)
         lo = st.bound
         if st.integer:
-            lo = float(math.ceil(lo - 1e-6))
+            lb, lo = np.ceil(lb - 1e-6), float(math.ceil(lo - 1e-6))
         times["fixing"] = time.perf_counter() - t0
         t0 = time.perf_counter()
         windows: list[dict[str, Any]] = []
@@ -279,6 +277,10 @@ class _LagrangianBase(Backend):
         terms (:class:`~.window.Outcome`); HiGHS's own status, when HiGHS ran, goes
         into the window record ``rec["native"]``.
         """
+        if _has_numba() and len(win) >= _SPLIT_MIN and (problem.tuples[win] == 0).any():
+            split = _by_components(problem, win, st, options, deadline)
+            if split is not None:           # it split, and every component settled
+                return split + ("components",)
         if _has_numba() or len(win) <= _SEARCH_MAX:
             if _has_numba():
                 nodes = _OPEN_NODES if skip else _COMPILED_NODES
@@ -323,10 +325,8 @@ class _LagrangianBase(Backend):
     # ------------------------------------------------------------- results
     def _finish(self, st: _State, info: dict[str, Any], t_start: float, gated: bool,
                 options: SolveOptions) -> RawResult:
-        info["iterations"] = st.iterations
-        info["stop"] = st.stop
-        info["proof"] = st.proof
-        info["bound_raw"] = st.bound if math.isfinite(st.bound) else None
+        info.update(iterations=st.iterations, stop=st.stop, proof=st.proof,
+                    bound_raw=st.bound if math.isfinite(st.bound) else None)
         if st.history is not None:
             info["history"] = st.history
         if gated:
