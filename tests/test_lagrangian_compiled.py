@@ -1,7 +1,7 @@
 """The compiled paths of ``lagrangian-exact`` against the plain ones: the dense-grid
 relaxation (axial 3-AP: :mod:`assocopt.solvers.kernels.grid`) against numpy and
 scipy's LAP, and the window policy that lets the compiled search give up on a window
-for a larger one to decide (:class:`assocopt.solvers.lagrangian.window._Skipper`)
+for a larger one to decide (:class:`assocopt.solvers.lagrangian.policy._Skipper`)
 against brute force.  No wall-clock assertions."""
 
 from __future__ import annotations
@@ -56,7 +56,7 @@ def test_grid_kernels_equal_numpy(seed, n):
 def _leave_windows(mp: pytest.MonkeyPatch, nodes: int, growth: float) -> None:
     """Give-up budget ``nodes``, successor growth ``growth``, no search in the ascent's
     fixing probes (else they settle small problems before any window)."""
-    from assocopt.solvers.lagrangian import backend as lb, window as lw
+    from assocopt.solvers.lagrangian import backend as lb, policy as lw
     mp.setattr(lb, "_OPEN_NODES", nodes)
     mp.setattr(lw, "_SKIP_GROWTH", growth)
     mp.setattr(lb, "_PROBE_SEARCH_MAX", 0)
@@ -101,7 +101,7 @@ def test_windows_left_to_larger_ones_equal_brute_force(p, policy):
 
 def test_skipper_goes_back_to_the_first_window():
     """Two windows given up: the first threshold comes back, then nothing is left."""
-    from assocopt.solvers.lagrangian.window import _Skipper
+    from assocopt.solvers.lagrangian.policy import _Skipper
     s = _Skipper()
     lb = np.arange(100, dtype=float)
     assert not s.may_skip(False, True, lb, 10, 10.0)        # next window: 11, not 20
@@ -121,14 +121,15 @@ def test_skipper_goes_back_to_the_first_window():
 @pytest.mark.parametrize("seed", range(4))
 def test_windows_solved_by_components_equal_highs(seed):
     """Gated scans closer than the gate (one component), a short ascent so that the
-    windows are large: the windows split and are solved component by component
-    (the path was taken), with HiGHS's optimum."""
+    windows are large, the first search cut to one node: the windows split and are
+    solved component by component (the path was taken), with HiGHS's optimum."""
     from benchmarks.tracking_scans import ScanSpec, build_problem
-    from assocopt.solvers.lagrangian import window as lw
+    from assocopt.solvers.lagrangian import policy as lw
     p, _ = build_problem(ScanSpec(N=4, n=30, spacing=0.8, seed=seed))
     with pytest.MonkeyPatch.context() as mp:
         mp.setattr(lw, "_SPLIT_MIN", 2)
         mp.setattr("assocopt.solvers.lagrangian.backend._SPLIT_MIN", 2)
+        mp.setattr("assocopt.solvers.lagrangian.backend._OPEN_NODES", 1)   # search first
         sol = solve(p, "lagrangian-exact", max_iter=4, decompose=False, local_search=False)
     assert_optimal(p, sol, reference=solve(p, "highs").objective)
     engines = {w.get("solver") for w in sol.info.get("windows", [])}
@@ -136,7 +137,7 @@ def test_windows_solved_by_components_equal_highs(seed):
 
 
 def test_connected_or_nested_windows_are_left_to_the_engines():
-    from assocopt.solvers.lagrangian import window as lw
+    from assocopt.solvers.lagrangian import policy as lw
     from assocopt.solvers.lagrangian.ascent import _State
     p = AssignmentProblem.dense(np.arange(27.0).reshape(3, 3, 3))   # one component
     st = _State(costs=p.costs, integer=True)

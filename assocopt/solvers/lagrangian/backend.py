@@ -24,10 +24,10 @@ from .local_search import _LocalSearch
 from .options import OPTIONS, OPTIONS_EXACT, check_engines
 from .reduction import dominated
 from .relaxation import _Relaxation
-from .window import (_COMPILED_NODES, _CPSAT_BUDGET, _CPSAT_MAX, _OPEN_NODES,
-                     _PROBE_SEARCH_MAX, _SEARCH_MAX, _SEARCH_NODES, _SPLIT_MIN, _Skipper,
-                     _by_components, _compiled_search, _cover_search, _cpsat, Outcome,
-                     _grow, _has_numba, _has_ortools, _ilp, _uncovered)
+from .policy import _OPEN_NODES, _SPLIT_MIN, _Skipper, _by_components, _search
+from .window import (_COMPILED_NODES, _CPSAT_BUDGET, _CPSAT_MAX, _PROBE_SEARCH_MAX,
+                     _SEARCH_MAX, _SEARCH_NODES, _compiled_search, _cover_search, _cpsat,
+                     Outcome, _grow, _has_numba, _has_ortools, _ilp, _uncovered)
 
 #: The exact mode runs the local search only above this many candidates.
 _LS_MIN_K = 2000
@@ -277,27 +277,18 @@ class _LagrangianBase(Backend):
         terms (:class:`~.window.Outcome`); HiGHS's own status, when HiGHS ran, goes
         into the window record ``rec["native"]``.
         """
-        if _has_numba() and len(win) >= _SPLIT_MIN and (problem.tuples[win] == 0).any():
-            split = _by_components(problem, win, st, options, deadline)
-            if split is not None:           # it split, and every component settled
-                return split + ("components",)
-        if _has_numba() or len(win) <= _SEARCH_MAX:
-            if _has_numba():
-                nodes = _OPEN_NODES if skip else _COMPILED_NODES
-                sel, complete = _compiled_search(problem, win, red_of[win], base, cap,
-                                                 st.integer, nodes)
-                how = "compiled search"
-            else:
-                sel, complete = _cover_search(problem, win, red_of[win], base, cap,
-                                              node_limit=_SEARCH_NODES)
-                how = "search"
-            if complete:
-                if sel is None:
-                    return Outcome.NONE_BELOW, None, how
-                st.offer(sel)
-                return Outcome.OPTIMAL, math.fsum(problem.costs[sel].tolist()), how
-            if skip:                      # a larger window decides (see _Skipper)
-                return Outcome.GAVE_UP, None, how
+        compiled = _has_numba()
+        skip = skip and compiled
+        split = compiled and len(win) >= _SPLIT_MIN and bool((problem.tuples[win] == 0).any())
+        args = (problem, win, red_of[win], base, cap, st, compiled, _SEARCH_MAX, _SEARCH_NODES)
+        found = _search(*args, _OPEN_NODES if skip or split else _COMPILED_NODES)
+        if found is None and split:     # its components, or (connected) the full search
+            found = _by_components(problem, win, st, options, deadline) or \
+                (None if skip else _search(*args, _COMPILED_NODES))
+        if found is not None:
+            return found
+        if skip:                        # a larger window decides (see _Skipper)
+            return Outcome.GAVE_UP, None, "compiled search" if compiled else "search"
         start = closed and st.incumbent is not None
         use_cp = st.integer and (p["window_solver"] == "cpsat" or (
             p["window_solver"] == "auto" and len(win) <= _CPSAT_MAX and _has_ortools()))

@@ -9,8 +9,6 @@ grows windows is :meth:`~.backend._LagrangianBase._close_gap`.
 
 from __future__ import annotations
 
-import contextvars
-import dataclasses
 import enum
 import math
 import time
@@ -18,10 +16,8 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
-from ...model.solution import Status
-from ...problems.components import local_tuples, split, subproblem
 from ...problems.problem import AssignmentProblem
-from ..base import SolveOptions, get_backend, module_installed
+from ..base import SolveOptions, module_installed
 from .ascent import _State
 from .options import OPT_TOL
 
@@ -39,13 +35,6 @@ _SEARCH_NODES = 5000
 #: With numba installed the compiled search (:func:`_compiled_search`) takes every
 #: window first, with this many nodes (tens of milliseconds).
 _COMPILED_NODES = 100_000
-#: ... and this many on a window that is not the last (a larger one can decide): the
-#: search gives up there in a few milliseconds instead of tenths of a second.
-_OPEN_NODES = 10_000
-#: The first window is left so only when the next (one cost unit up) holds at least
-#: this many times its candidates (Grundel n = 40-50: 2.3-15 times; Balas-Saltzman, whose
-#: windows do not get easier as they grow: about 1.3).
-_SKIP_GROWTH = 2.0
 #: Windows up to this many candidates (integer costs) go to CP-SAT, larger ones to
 #: HiGHS: CP-SAT settles the small exact-cover windows of Balas-Saltzman instances
 #: several times faster, HiGHS's LP wins on large ones (measured, Grundel n = 50).
@@ -56,16 +45,6 @@ _CPSAT_BUDGET = 1.0
 #: feasibility jump off was tried on Grundel n = 50 and did not pay, so HiGHS runs
 #: with its defaults (plus the objective target set below).
 _HIGHS_OPTIONS: dict[str, Any] = {}
-
-
-#: Windows of problems with dummies, of at least this many candidates, are solved by
-#: connected components when they split (fixing cuts the couplings: the largest
-#: windows of the gated N = 4-5 scans, 800-3 100 candidates, split into 50-100
-#: components of at most 80-620; ``bnb`` settled them in 2-140 ms where the search
-#: over the whole window ran out of nodes and HiGHS took 0.3-1.3 s).
-_SPLIT_MIN = 200
-#: Set while the components of a window are solved (their own windows stay whole).
-_NESTED = contextvars.ContextVar("assocopt_window_nested", default=False)
 
 
 class Outcome(str, enum.Enum):
@@ -85,7 +64,8 @@ class Outcome(str, enum.Enum):
     LIMIT = "limit"
     ERROR = "error"
     #: the compiled search spent its nodes on a window that is not the last: a larger
-    #: window (which holds this one) decides instead of CP-SAT or HiGHS
+    #: window (which holds this one) decides instead of CP-SAT or HiGHS (see
+    #: :mod:`.policy`)
     GAVE_UP = "gave_up"
 
     def __str__(self) -> str:
@@ -98,40 +78,6 @@ _HIGHS_OUTCOME: dict[str, Outcome] = {
     "kObjectiveTarget": Outcome.AT_BOUND, "kTimeLimit": Outcome.LIMIT,
     "kInterrupt": Outcome.LIMIT,
 }
-
-
-class _Skipper:
-    """Which windows the compiled search may give up on (after :data:`_OPEN_NODES`
-    nodes) for a larger window to decide: the first one, when the next is much
-    larger, and then the next; if that one gives up too, the first gets the full
-    treatment (search, CP-SAT, HiGHS) after all (measured on Grundel n = 50: the
-    small first window sometimes holds the optimum, which CP-SAT finds there in
-    0.15 s and HiGHS needs 2 s for in the next).  Integer costs only."""
-
-    def __init__(self) -> None:
-        self.tries, self.first, self.force, self.floor = 2, None, None, -math.inf
-
-    def threshold(self, T: float, integer: bool, ub: float) -> float:
-        """The next threshold: the first window again, or one above those given up."""
-        if self.force is not None:
-            T, self.force = self.force, None
-        elif T <= self.floor:
-            T = self.floor + 1.0 if integer else ub
-        return T
-
-    def may_skip(self, closed: bool, integer: bool, lb: np.ndarray, n_in: int,
-                 T: float) -> bool:
-        if self.tries == 1:
-            return True
-        return self.tries == 2 and integer and not closed and \
-            int(np.searchsorted(lb, T + 1.0, "left")) >= _SKIP_GROWTH * max(n_in, 1)
-
-    def gave_up(self, T: float) -> None:
-        self.tries -= 1
-        if self.first is None:
-            self.first = self.floor = T
-        else:
-            self.force, self.floor, self.tries = self.first, -math.inf, 0
 
 
 def _grow(n: int, integer: bool) -> int:
@@ -175,46 +121,6 @@ def _compiled_search(problem: AssignmentProblem, pos: np.ndarray, red: np.ndarra
 
 def _has_ortools() -> bool:
     return module_installed("ortools")
-
-
-def _by_components(problem: AssignmentProblem, pos: np.ndarray, st: _State,
-                   options: SolveOptions, deadline: float | None
-                   ) -> tuple[Outcome, float | None] | None:
-    """The best solution of the window ``pos`` (every row covered), component by
-    component (``bnb`` on each, which hands what it cannot settle to
-    ``lagrangian-exact``); None when the window is connected, or nested, or a
-    component was not settled (time limit): the caller's engines decide then."""
-    if _NESTED.get():
-        return None
-    W = AssignmentProblem._build(problem.sizes, problem.tuples[pos], problem.costs[pos],
-                                 problem.slack[pos], kind="sparse")
-    sp = split(W)
-    if sp.n < 2:
-        return None
-    T, csizes = local_tuples(W, sp.of_row, sp.n)
-    bnb, sel = get_backend("bnb"), []
-    token = _NESTED.set(True)
-    try:
-        for c in range(sp.n):
-            cand = sp.order[sp.ptr[c]:sp.ptr[c + 1]]
-            left = None if deadline is None else deadline - time.perf_counter()
-            if sp.trivial[c] or (left is not None and left <= 0):
-                sel.append(cand)              # the only cover (or out of time: checked)
-                continue
-            o = dataclasses.replace(options, extra={}, parsed=False, time_limit=left)
-            raw = bnb().solve(subproblem(W, T, csizes[c], cand), o)
-            if raw.status is Status.INFEASIBLE:
-                return Outcome.NONE_BELOW, None
-            if raw.status is not Status.OPTIMAL or raw.selected is None:
-                return None
-            sel.append(cand[np.asarray(raw.selected, np.int64)])
-    finally:
-        _NESTED.reset(token)
-    if deadline is not None and time.perf_counter() > deadline:
-        return None
-    chosen = np.sort(pos[np.concatenate(sel)])
-    st.offer(chosen)
-    return Outcome.OPTIMAL, math.fsum(problem.costs[chosen].tolist())
 
 
 def _uncovered(problem: AssignmentProblem, pos: np.ndarray) -> np.ndarray:
