@@ -115,10 +115,13 @@ def _by_components(problem: AssignmentProblem, pos: np.ndarray, st: _State,
         for c in range(sp.n):
             cand = sp.order[sp.ptr[c]:sp.ptr[c + 1]]
             left = None if deadline is None else deadline - time.perf_counter()
-            if sp.trivial[c] or (left is not None and left <= 0):
-                sel.append(cand)              # the only cover (or out of time: checked)
+            if left is not None and left <= 0:
+                return None
+            if sp.trivial[c]:
+                sel.append(cand)              # the only cover
                 continue
-            o = dataclasses.replace(options, extra={}, parsed=False, time_limit=left)
+            o = dataclasses.replace(options, extra={}, parsed=False, time_limit=left,
+                                    mip_gap=0.0)
             raw = bnb().solve(subproblem(W, T, csizes[c], cand), o)
             if raw.status is Status.INFEASIBLE:
                 return Outcome.NONE_BELOW, None, "components"
@@ -127,8 +130,6 @@ def _by_components(problem: AssignmentProblem, pos: np.ndarray, st: _State,
             sel.append(cand[np.asarray(raw.selected, np.int64)])
     finally:
         _NESTED.reset(token)
-    if deadline is not None and time.perf_counter() > deadline:
-        return None
     chosen = np.sort(pos[np.concatenate(sel)])
     st.offer(chosen)
     return Outcome.OPTIMAL, math.fsum(problem.costs[chosen].tolist()), "components"
