@@ -212,8 +212,16 @@ _COMPARED = [
     "that holds every solution cheaper than T; windows grow until T reaches the "
     "incumbent and are solved by the compiled exact-cover search (numba, up to "
     "100,000 nodes), then CP-SAT (integer costs, <= 1,500 candidates, 1 s budget) "
-    "or HiGHS (stopped at the proven bound).  Proven optimum, no tolerance beyond "
-    "floating-point round-off.",
+    "or HiGHS (stopped at the proven bound).  A window of a problem with dummies "
+    "that splits into connected components is solved component by component "
+    "(`bnb` on each) when a first search of 10,000 nodes does not settle it; with "
+    "integer costs the search may give up on the first window after 10,000 nodes "
+    "when the next one holds at least twice its candidates (the larger window "
+    "decides; if it gives up too, the first gets the full treatment).  On dense "
+    "axial problems (3-AP) one compiled kernel evaluates the relaxation (minimum "
+    "over the relaxed axis, Hungarian method warm-started from the last "
+    "iteration's potentials) and the recovery.  Proven optimum, no tolerance "
+    "beyond floating-point round-off.",
     "- `auto`: what `solve(p)` picks: `bnb` up to 10,000 candidates, else "
     "`lagrangian-exact`.  `bnb` runs in one compiled call: the same relaxation "
     "with a dense Hungarian method, N = 3 primal recovery each iteration, then a "

@@ -74,7 +74,8 @@ Modules
 :func:`lagrangian_bound`), :mod:`.local_search` (axis-wise re-assignment),
 :mod:`.reduction` (the dominance rule :func:`dominated`), :mod:`.ascent` (solve
 state and the subgradient ascent), :mod:`.window` (exact search, CP-SAT and HiGHS on
-candidate windows), :mod:`.backend` (the two registered back ends).
+candidate windows), :mod:`.policy` (windows solved by components, windows left to a
+larger one), :mod:`.backend` (the two registered back ends).
 
 May import: :mod:`assocopt.runtime`, :mod:`assocopt.problems`, :mod:`assocopt.model`;
 in :mod:`assocopt.solvers` the top-level modules (:mod:`assocopt.solvers.base`,

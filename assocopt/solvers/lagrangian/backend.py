@@ -24,6 +24,7 @@ from .local_search import _LocalSearch
 from .options import OPTIONS, OPTIONS_EXACT, check_engines
 from .reduction import dominated
 from .relaxation import _Relaxation
+from .policy import _OPEN_NODES, _SPLIT_MIN, _Skipper, _by_components, _search
 from .window import (_COMPILED_NODES, _CPSAT_BUDGET, _CPSAT_MAX, _PROBE_SEARCH_MAX,
                      _SEARCH_MAX, _SEARCH_NODES, _compiled_search, _cover_search, _cpsat,
                      Outcome, _grow, _has_numba, _has_ortools, _ilp, _uncovered)
@@ -40,7 +41,6 @@ class _LagrangianBase(Backend):
     gives_bound = True
     supports_time_limit = True
     _exact: bool = False
-
     own_method = True
 
     def solve(self, problem: AssignmentProblem, options: SolveOptions) -> RawResult:
@@ -101,10 +101,8 @@ class _LagrangianBase(Backend):
                                 f"problem on axes {keep} has no assignment ({exc})")
         times["ascent"] = time.perf_counter() - t0
         info["ascent_stop"] = st.stop
-
         if self._exact and st.stop not in ("proven", "time_limit", "gap_tol"):
             self._close_gap(problem, rel, pos, upad, st, p, options, deadline, info, times)
-
         if st.incumbent is None and problem.n_candidates <= 200_000 and \
                 (deadline is None or time.perf_counter() < deadline):
             from ..baseline.greedy import greedy_select
@@ -167,7 +165,8 @@ class _LagrangianBase(Backend):
         window costs less than ``T`` it is optimal, and if none does, ``T`` is a new
         lower bound.  Windows grow (by candidate count) until ``T`` reaches the
         incumbent, whose window (with the incumbent added) is the classic fixing
-        step.  Each window goes to the cover search, CP-SAT or HiGHS (see ``window``).
+        step.  Each window goes to its components (when it splits), the cover search,
+        CP-SAT or HiGHS (see ``window``).
         """
         t0 = time.perf_counter()
         lb, red, base = rel.fixing_bounds(upad)
@@ -176,16 +175,15 @@ class _LagrangianBase(Backend):
         red_of[gpos] = red
         order = np.argsort(lb, kind="stable")
         lb, gpos = lb[order], gpos[order]
-        if st.integer:
-            lb = np.ceil(lb - 1e-6)
         lo = st.bound
         if st.integer:
-            lo = float(math.ceil(lo - 1e-6))
+            lb, lo = np.ceil(lb - 1e-6), float(math.ceil(lo - 1e-6))
         times["fixing"] = time.perf_counter() - t0
         t0 = time.perf_counter()
         windows: list[dict[str, Any]] = []
         info["windows"] = windows
         budget = 2 * problem.n_rows
+        skip = _Skipper()
         while True:
             st.bound = max(st.bound, min(lo, st.ub))
             if st.incumbent is not None and st.closes(st.bound):
@@ -205,6 +203,7 @@ class _LagrangianBase(Backend):
             T = lo + 1.0 if st.integer else lo + st.tol()
             if int(np.searchsorted(lb, T, "left")) < budget and K:
                 T = max(T, float(lb[min(budget, K - 1)]))
+            T = skip.threshold(T, st.integer, st.ub)
             final = T >= st.ub
             if final:
                 T = st.ub
@@ -231,9 +230,14 @@ class _LagrangianBase(Backend):
                 budget = max(budget, _grow(n_in, st.integer))
                 continue
             cap = st.ub if closed else T          # only solutions below cap matter
+            leave = skip.may_skip(closed, st.integer, lb, n_in, T)
             status, z, how = self._window(problem, win, red_of, base, lo, cap, closed,
-                                          st, p, options, deadline, rec)
+                                          st, p, options, deadline, rec, leave)
             rec["result"], rec["solver"] = status.value, how
+            if status is Outcome.GAVE_UP:     # a larger window holds this one
+                skip.gave_up(T)
+                budget = max(budget, _grow(n_in, st.integer))
+                continue
             if status is Outcome.AT_BOUND or (status is Outcome.OPTIMAL and
                                               (closed or (z is not None and z < cap))):
                 if st.incumbent is None:
@@ -265,28 +269,26 @@ class _LagrangianBase(Backend):
     @staticmethod
     def _window(problem: AssignmentProblem, win: np.ndarray, red_of: np.ndarray, base: float,
                 lo: float, cap: float, closed: bool, st: _State, p: dict[str, Any],
-                options: SolveOptions, deadline: float | None, rec: dict[str, Any]
-                ) -> tuple[Outcome, float | None, str]:
+                options: SolveOptions, deadline: float | None, rec: dict[str, Any],
+                skip: bool = False) -> tuple[Outcome, float | None, str]:
         """Best solution among the candidates ``win`` costing less than ``cap``.
 
         Returns ``(outcome, objective, engine)``, the outcome in the engines' common
         terms (:class:`~.window.Outcome`); HiGHS's own status, when HiGHS ran, goes
         into the window record ``rec["native"]``.
         """
-        if _has_numba() or len(win) <= _SEARCH_MAX:
-            if _has_numba():
-                sel, complete = _compiled_search(problem, win, red_of[win], base, cap,
-                                                 st.integer, _COMPILED_NODES)
-                how = "compiled search"
-            else:
-                sel, complete = _cover_search(problem, win, red_of[win], base, cap,
-                                              node_limit=_SEARCH_NODES)
-                how = "search"
-            if complete:
-                if sel is None:
-                    return Outcome.NONE_BELOW, None, how
-                st.offer(sel)
-                return Outcome.OPTIMAL, math.fsum(problem.costs[sel].tolist()), how
+        compiled = _has_numba()
+        skip = skip and compiled
+        split = compiled and len(win) >= _SPLIT_MIN and bool((problem.tuples[win] == 0).any())
+        args = (problem, win, red_of[win], base, cap, st, compiled, _SEARCH_MAX, _SEARCH_NODES)
+        found = _search(*args, _OPEN_NODES if skip or split else _COMPILED_NODES)
+        if found is None and split:     # its components, or (connected) the full search
+            found = _by_components(problem, win, st, options, deadline) or \
+                (None if skip else _search(*args, _COMPILED_NODES))
+        if found is not None:
+            return found
+        if skip:                        # a larger window decides (see _Skipper)
+            return Outcome.GAVE_UP, None, "compiled search" if compiled else "search"
         start = closed and st.incumbent is not None
         use_cp = st.integer and (p["window_solver"] == "cpsat" or (
             p["window_solver"] == "auto" and len(win) <= _CPSAT_MAX and _has_ortools()))
@@ -314,10 +316,8 @@ class _LagrangianBase(Backend):
     # ------------------------------------------------------------- results
     def _finish(self, st: _State, info: dict[str, Any], t_start: float, gated: bool,
                 options: SolveOptions) -> RawResult:
-        info["iterations"] = st.iterations
-        info["stop"] = st.stop
-        info["proof"] = st.proof
-        info["bound_raw"] = st.bound if math.isfinite(st.bound) else None
+        info.update(iterations=st.iterations, stop=st.stop, proof=st.proof,
+                    bound_raw=st.bound if math.isfinite(st.bound) else None)
         if st.history is not None:
             info["history"] = st.history
         if gated:

@@ -15,8 +15,13 @@ import numpy as np
 
 from ...runtime.errors import InvalidProblemError
 from ...problems.problem import AssignmentProblem
+from ..base import module_installed
 from ..twod.lap import (Assignment2D, LapInfeasibleError, assign_with_misses, assignment_duals,
                    linear_assignment)
+
+
+def _numba_installed() -> bool:
+    return module_installed("numba")
 
 
 def _ranges(starts: np.ndarray, counts: np.ndarray) -> np.ndarray:
@@ -119,6 +124,13 @@ class _Relaxation:
                 # evaluate() needs no gathers at all (dense axial 3-D tensors)
                 self.grid = (self.simple and G == na * nb and not self.has_miss and
                              np.array_equal(tails[0, :, 0], np.arange(1, m + 1)))
+        # square dense grid (axial 3-AP): compiled evaluation and recovery when numba
+        # is installed (the LAP method left to us); column potentials kept warm
+        self.compiled = self.grid and na == nb and lap in ("auto", "sparse") and \
+            _numba_installed()
+        if self.compiled:
+            self.Cg = np.ascontiguousarray(self.Cg, np.float64)
+            self.v_eval = self.v_rec = np.empty(0)
         self.dense = None
         if na * nb <= 4_000_000 and (na * nb <= 40_000 or 8 * len(self.pair_g) >= na * nb):
             self.dense = np.full((na, nb), np.inf)
@@ -148,6 +160,9 @@ class _Relaxation:
     def _evaluate_grid(self, upad: np.ndarray, full_rc: bool = False) -> _Eval:
         off = int(self.u_off[0])
         w = upad[off + 1: off + 1 + self.m]
+        ev = self._evaluate_compiled(w, off) if self.compiled and not full_rc else None
+        if ev is not None:
+            return ev
         Mg = self.Cg - w
         am = Mg.argmin(axis=1)
         gmin = Mg[self.g_range, am]
@@ -165,6 +180,31 @@ class _Relaxation:
             cor[r], roc[c] = c, r
             asg = Assignment2D(cor, roc, "plain")
         return _Eval(value, sel, g, chosen, Mg.ravel() if full_rc else None, gmin, asg, 0.0)
+
+    def _evaluate_compiled(self, w: np.ndarray, off: int) -> _Eval | None:
+        """:meth:`_evaluate_grid` by the kernel (None: its LAP found no matching)."""
+        from ..kernels import ensure
+        from ..kernels.grid import grid_eval
+        args = (self.Cg, np.ascontiguousarray(w), self.na, self.v_eval)
+        ensure(grid_eval, *args)
+        ok, value, chosen, am, gmin, v = grid_eval(*args)
+        if not ok:
+            return None
+        self.v_eval = v
+        g = np.zeros(self.u_len)
+        g[off + 1: off + 1 + self.m] = 1.0 - np.bincount(am[chosen], minlength=self.m)
+        return _Eval(value, chosen * self.m + am[chosen], g, chosen, None, gmin, None, 0.0)
+
+    def _recover_compiled(self, chosen: np.ndarray) -> np.ndarray | None:
+        from ..kernels import ensure
+        from ..kernels.grid import grid_recover
+        args = (self.Cg, np.ascontiguousarray(chosen, np.int64), self.v_rec)
+        ensure(grid_recover, *args)
+        ok, sel, v = grid_recover(*args)
+        if not ok:
+            return None
+        self.v_rec = v
+        return sel
 
     def evaluate(self, upad: np.ndarray, full_rc: bool = False) -> _Eval:
         if self.grid:
@@ -227,6 +267,10 @@ class _Relaxation:
         if self.simple:
             # every chosen group is a pair or a miss: give each one index of the relaxed
             # axis (square: as many groups as indices only when nothing was missed)
+            if self.compiled and len(chosen) == self.m:
+                sel = self._recover_compiled(chosen)
+                if sel is not None:
+                    return sel
             M = self.Cg[chosen]
             if M.shape[0] == M.shape[1]:
                 try:

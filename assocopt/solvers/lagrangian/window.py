@@ -54,7 +54,8 @@ class Outcome(str, enum.Enum):
     at least the cap, none below the cap exists); ``NONE_BELOW``: proven that nothing
     in the window costs less than the cap; ``AT_BOUND``: a solution at the proven
     lower bound was found (so it is optimal); ``LIMIT``: a time limit stopped the
-    engine; ``ERROR``: the engine failed (its own status is in the window record).
+    engine; ``ERROR``: the engine failed (its own status is in the window record);
+    ``GAVE_UP``: nothing settled, the next window decides.
     """
 
     OPTIMAL = "optimal"
@@ -62,6 +63,10 @@ class Outcome(str, enum.Enum):
     AT_BOUND = "at_bound"
     LIMIT = "limit"
     ERROR = "error"
+    #: the compiled search spent its nodes on a window that is not the last: a larger
+    #: window (which holds this one) decides instead of CP-SAT or HiGHS (see
+    #: :mod:`.policy`)
+    GAVE_UP = "gave_up"
 
     def __str__(self) -> str:
         return self.value

@@ -1,0 +1,95 @@
+"""Connected components of an S-D problem: two candidates are connected when they
+share a real index, and no constraint couples two components, so each can be solved
+alone.  Used by :mod:`assocopt.solving.decompose` (whole problems) and by the
+``lagrangian-exact`` windows (candidate subsets left by reduced-cost fixing, which
+split much further than the problem they come from).
+
+Components are found in bulk: a graph on the real indices (constraint rows) with an
+edge from each candidate's first real index to each of its other ones, and
+:func:`scipy.sparse.csgraph.connected_components` on it.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from .problem import AssignmentProblem
+
+__all__ = ["Split", "split", "local_tuples", "subproblem"]
+
+
+@dataclass(frozen=True)
+class Split:
+    """The components of a problem.
+
+    ``n``: how many; ``of_row`` (E,) and ``of_cand`` (K,): the component of each
+    real index (constraint row) and candidate; ``order`` the candidates sorted by
+    component, ``ptr`` (n+1,) where each component's run starts; ``trivial`` (n,):
+    every real index of the component has exactly one candidate.
+    """
+
+    n: int
+    of_row: np.ndarray
+    of_cand: np.ndarray
+    order: np.ndarray
+    ptr: np.ndarray
+    trivial: np.ndarray
+
+    @property
+    def sizes(self) -> np.ndarray:
+        """Candidates per component."""
+        return np.diff(self.ptr)
+
+
+def split(problem: AssignmentProblem) -> Split:
+    """The connected components of ``problem`` (every real index covered)."""
+    from scipy.sparse import csr_matrix
+    from scipy.sparse.csgraph import connected_components
+
+    R = problem.entry_rows
+    K, E = len(R), problem.n_rows
+    real = R >= 0
+    first = R[np.arange(K), np.argmax(real, axis=1)]
+    src = np.broadcast_to(first[:, None], R.shape)[real]
+    dst = R[real][np.argsort(src, kind="stable")]
+    ptr = np.zeros(E + 1, np.int64)                # CSR built directly (no COO pass)
+    np.cumsum(np.bincount(src, minlength=E), out=ptr[1:])
+    idx = np.int32 if E < 2 ** 31 else np.int64
+    graph = csr_matrix((np.ones(len(dst)), dst.astype(idx), ptr.astype(idx)), shape=(E, E))
+    n, of_row = connected_components(graph, directed=False)
+    of_row = of_row.astype(np.int64)
+    of_cand = of_row[first]
+    order = np.argsort(of_cand, kind="stable")
+    ptr = np.zeros(n + 1, np.int64)
+    np.cumsum(np.bincount(of_cand, minlength=n), out=ptr[1:])
+    cover = np.bincount(R[real], minlength=E)
+    trivial = np.bincount(of_row[cover > 1], minlength=n) == 0
+    return Split(n, of_row, of_cand, order, ptr, trivial)
+
+
+def local_tuples(problem: AssignmentProblem, part_of_row: np.ndarray, n_parts: int
+                 ) -> tuple[np.ndarray, np.ndarray]:
+    """Each candidate's tuple relabelled within its part (parts: groups of whole
+    components), ``(K, N)``, and the parts' axis sizes, ``(n_parts, N)``: the real
+    indices of a part on axis s become ``1..n_s`` in their original order."""
+    N = problem.ndim
+    axis_of_row = np.repeat(np.arange(N), problem.sizes)
+    key = part_of_row * N + axis_of_row
+    order = np.argsort(key, kind="stable")
+    counts = np.bincount(key, minlength=n_parts * N)
+    start = np.concatenate([[0], np.cumsum(counts)[:-1]])
+    local = np.empty(len(key), np.int64)
+    local[order] = np.arange(len(key)) - start[key[order]] + 1
+    R = problem.entry_rows
+    T = np.where(R >= 0, local[np.maximum(R, 0)], 0)
+    return T, counts.reshape(n_parts, N)
+
+
+def subproblem(problem: AssignmentProblem, T: np.ndarray, sizes: np.ndarray,
+                cand: np.ndarray) -> AssignmentProblem:
+    """The problem of candidates ``cand`` (tuples already relabelled in ``T``)."""
+    return AssignmentProblem._build(tuple(int(v) for v in sizes), T[cand],
+                                    problem.costs[cand], problem.slack[cand],
+                                    kind="sparse")

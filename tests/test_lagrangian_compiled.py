@@ -1,0 +1,152 @@
+"""The compiled paths of ``lagrangian-exact`` against the plain ones: the dense-grid
+relaxation (axial 3-AP: :mod:`assocopt.solvers.kernels.grid`) against numpy and
+scipy's LAP, and the window policy that lets the compiled search give up on a window
+for a larger one to decide (:class:`assocopt.solvers.lagrangian.policy._Skipper`)
+against brute force.  No wall-clock assertions."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
+
+from assocopt import AssignmentProblem, Status, solve
+from assocopt.testing import assert_optimal
+
+from conftest import sd_problems
+
+pytest.importorskip("numba")
+
+
+def _relaxations(C: np.ndarray):
+    from assocopt.solvers.lagrangian import relaxation as R
+    p = AssignmentProblem.dense(C)
+    args = (p.sizes, p.tuples, p.costs, (0, 1), "auto")
+    fast = R._Relaxation(*args)
+    with pytest.MonkeyPatch.context() as mp:
+        mp.setattr(R, "_numba_installed", lambda: False)
+        slow = R._Relaxation(*args)
+    return fast, slow
+
+
+@pytest.mark.parametrize("seed", range(6))
+@pytest.mark.parametrize("n", [1, 2, 5, 12])
+def test_grid_kernels_equal_numpy(seed, n):
+    """Same L(u) and subgradient norm (ties may pick other pairs of equal value), a
+    selection of that value, and a recovery as cheap as scipy's LAP on the same
+    chosen pairs, at successive multipliers (warm potentials carried over)."""
+    rng = np.random.default_rng(seed)
+    C = rng.integers(0, 30, (n, n, n)).astype(float) if seed % 2 else rng.random((n, n, n))
+    fast, slow = _relaxations(C)
+    assert fast.compiled and not slow.compiled
+    u = fast.initial_multipliers()
+    for _ in range(8):
+        a, b = fast.evaluate(u), slow.evaluate(u)
+        assert a.value == pytest.approx(b.value, abs=1e-9)
+        rc = fast.reduced_costs(u)
+        assert rc[a.selected].sum() + u.sum() == pytest.approx(a.value, abs=1e-9)
+        ra, rb = fast.recover(u, a.chosen), slow.recover(u, a.chosen)
+        assert ra is not None and rb is not None
+        assert np.array_equal(ra, np.sort(ra))
+        assert fast.c[ra].sum() == pytest.approx(slow.c[rb].sum(), abs=1e-9)
+        u = u + rng.normal(0.0, 1.0, len(u)) * (fast.evaluate(u).subgradient != 0)
+
+
+def _leave_windows(mp: pytest.MonkeyPatch, nodes: int, growth: float) -> None:
+    """Give-up budget ``nodes``, successor growth ``growth``, no search in the ascent's
+    fixing probes (else they settle small problems before any window)."""
+    from assocopt.solvers.lagrangian import backend as lb, policy as lw
+    mp.setattr(lb, "_OPEN_NODES", nodes)
+    mp.setattr(lw, "_SKIP_GROWTH", growth)
+    mp.setattr(lb, "_PROBE_SEARCH_MAX", 0)
+
+
+def test_windows_left_to_larger_ones_equal_highs():
+    """Dense integer 3-AP, n = 4..7, short ascent: every window eligible and given up
+    at once, so the first comes back after the second; same optimum as HiGHS, and
+    the path was taken."""
+    seen = set()
+    for seed in range(24):
+        rng = np.random.default_rng(seed)
+        n = int(rng.integers(4, 8))
+        p = AssignmentProblem.dense(rng.integers(0, 20, (n, n, n)).astype(float))
+        with pytest.MonkeyPatch.context() as mp:
+            _leave_windows(mp, 1, 0.0)
+            sol = solve(p, "lagrangian-exact", max_iter=5)
+        assert_optimal(p, sol, reference=solve(p, "highs").objective)
+        results = [w.get("result") for w in sol.info.get("windows", [])]
+        seen.add(tuple(results[:3]))
+    assert ("gave_up", "gave_up", "none_below_cap") in seen
+    assert ("gave_up", "gave_up", "optimal") in seen
+
+
+@given(sd_problems(dummies=False), st.sampled_from([(1, 0.0), (1, 2.0), (50, 0.0)]))
+@settings(max_examples=40, deadline=None)
+def test_windows_left_to_larger_ones_equal_brute_force(p, policy):
+    """With the give-up budget cut to ``nodes`` and every first window eligible
+    (growth 0), or only those whose successor is twice as large, the windows left to
+    larger ones, the first one solved after all, give brute force's optimum."""
+    nodes, growth = policy
+    with pytest.MonkeyPatch.context() as mp:
+        _leave_windows(mp, nodes, growth)
+        sol = solve(p, "lagrangian-exact", max_iter=3)
+    ref = solve(p, "bruteforce")
+    if ref.status is Status.INFEASIBLE:
+        assert sol.status is Status.INFEASIBLE
+        return
+    assert_optimal(p, sol)
+    assert sol.objective == pytest.approx(ref.objective, abs=1e-7 * max(1, abs(ref.objective)))
+
+
+def test_skipper_goes_back_to_the_first_window():
+    """Two windows given up: the first threshold comes back, then nothing is left."""
+    from assocopt.solvers.lagrangian.policy import _Skipper
+    s = _Skipper()
+    lb = np.arange(100, dtype=float)
+    assert not s.may_skip(False, True, lb, 10, 10.0)        # next window: 11, not 20
+    lb = np.sort(np.concatenate([lb, np.full(50, 10.0)]))
+    assert not s.may_skip(False, False, lb, 10, 10.0)       # real costs: never
+    assert not s.may_skip(True, True, lb, 10, 10.0)         # the last window: never
+    assert s.may_skip(False, True, lb, 10, 10.0)            # next holds 61 >= 2 * 10
+    s.gave_up(10.0)
+    assert s.threshold(10.0, True, 50.0) == 11.0           # one above the one left
+    assert s.may_skip(True, True, lb, 11, 11.0)            # the second may give up too
+    s.gave_up(11.0)
+    assert s.threshold(12.0, True, 50.0) == 10.0           # back to the first
+    assert not s.may_skip(False, True, lb, 10, 10.0)
+    assert s.threshold(11.0, True, 50.0) == 11.0
+
+
+@pytest.mark.parametrize("seed", range(4))
+def test_windows_solved_by_components_equal_highs(seed):
+    """Gated scans closer than the gate (one component), a short ascent so that the
+    windows are large, the first search cut to one node: the windows split and are
+    solved component by component (the path was taken), with HiGHS's optimum."""
+    from benchmarks.tracking_scans import ScanSpec, build_problem
+    from assocopt.solvers.lagrangian import policy as lw
+    p, _ = build_problem(ScanSpec(N=4, n=30, spacing=0.8, seed=seed))
+    with pytest.MonkeyPatch.context() as mp:
+        mp.setattr(lw, "_SPLIT_MIN", 2)
+        mp.setattr("assocopt.solvers.lagrangian.backend._SPLIT_MIN", 2)
+        mp.setattr("assocopt.solvers.lagrangian.backend._OPEN_NODES", 1)   # search first
+        sol = solve(p, "lagrangian-exact", max_iter=4, decompose=False, local_search=False)
+    assert_optimal(p, sol, reference=solve(p, "highs").objective)
+    engines = {w.get("solver") for w in sol.info.get("windows", [])}
+    assert "components" in engines, sol.info.get("windows")
+
+
+def test_connected_or_nested_windows_are_left_to_the_engines():
+    from assocopt.solvers.lagrangian import policy as lw
+    from assocopt.solvers.lagrangian.ascent import _State
+    p = AssignmentProblem.dense(np.arange(27.0).reshape(3, 3, 3))   # one component
+    st = _State(costs=p.costs, integer=True)
+    from assocopt.solvers.base import SolveOptions
+    assert lw._by_components(p, np.arange(27), st, SolveOptions(), None) is None
+    token = lw._NESTED.set(True)
+    try:
+        q = AssignmentProblem.sparse((2, 2, 2), [[1, 1, 1], [2, 2, 2]], [1.0, 2.0])
+        assert lw._by_components(q, np.arange(2), _State(costs=q.costs, integer=True),
+                                 SolveOptions(), None) is None
+    finally:
+        lw._NESTED.reset(token)
