@@ -22,10 +22,13 @@ pytest.importorskip("numba")
 def _relaxations(C: np.ndarray):
     from assocopt.solvers.lagrangian import relaxation as R
     p = AssignmentProblem.dense(C)
+    from assocopt.solvers.kernels import tiers
     args = (p.sizes, p.tuples, p.costs, (0, 1), "auto")
-    fast = R._Relaxation(*args)
     with pytest.MonkeyPatch.context() as mp:
-        mp.setattr(R, "_numba_installed", lambda: False)
+        mp.setattr(tiers, "_MODE", ["compiled"])      # small grids: else numpy's route
+        fast = R._Relaxation(*args)
+    with pytest.MonkeyPatch.context() as mp:
+        mp.setattr(R, "_numba_installed", lambda *work: False)
         slow = R._Relaxation(*args)
     return fast, slow
 
@@ -150,3 +153,17 @@ def test_connected_or_nested_windows_are_left_to_the_engines():
                                  SolveOptions(), None) is None
     finally:
         lw._NESTED.reset(token)
+
+
+def test_small_grids_take_numpy_by_default(monkeypatch):
+    """By the default rule a dense grid of at most the kernel's limit in entries takes
+    the numpy route (kernels.tiers: compiling would not pay), a larger one the kernel."""
+    from assocopt.solvers.kernels import tiers
+    from assocopt.solvers.lagrangian import relaxation as R
+    monkeypatch.delenv("ASSOCOPT_JIT", raising=False)
+    monkeypatch.setattr(tiers, "_MODE", [None])
+    monkeypatch.setattr(tiers, "_SPENT", {})
+    for n, compiled in ((5, False), (12, True)):
+        p = AssignmentProblem.dense(np.random.default_rng(n).random((n, n, n)))
+        rel = R._Relaxation(p.sizes, p.tuples, p.costs, (0, 1), "auto")
+        assert rel.compiled is compiled, n

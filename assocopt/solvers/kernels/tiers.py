@@ -74,6 +74,9 @@ LIMITS: dict[str, float] = {
     # candidates; a net grows with its cluster's width (dense 8 x 9: 0.11 s,
     # 10 x 10: 1 s, 12 x 12: 39 s interpreted)
     "ehm_exact.exact_marginals": 100,
+    # grid entries of a dense 3-AP; below, the Lagrangian relaxation's numpy route
+    # (no plain twin: numpy is quicker than the kernel interpreted)
+    "grid.grid_eval": 1_000,
 }
 
 _MODE: list[str | None] = [None]

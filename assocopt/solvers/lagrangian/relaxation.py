@@ -20,8 +20,11 @@ from ..twod.lap import (Assignment2D, LapInfeasibleError, assign_with_misses, as
                    linear_assignment)
 
 
-def _numba_installed() -> bool:
-    return module_installed("numba")
+def _numba_installed(work: float = 0.0) -> bool:
+    """numba installed, and worth compiling for ``work`` (else numpy: kernels.tiers)."""
+    from ..kernels import tiers
+    return module_installed("numba") and not tiers.interpret("grid.grid_eval", work,
+                                                             lambda: False)
 
 
 def _ranges(starts: np.ndarray, counts: np.ndarray) -> np.ndarray:
@@ -127,7 +130,7 @@ class _Relaxation:
         # square dense grid (axial 3-AP): compiled evaluation and recovery when numba
         # is installed (the LAP method left to us); column potentials kept warm
         self.compiled = self.grid and na == nb and lap in ("auto", "sparse") and \
-            _numba_installed()
+            _numba_installed(na * na * m)
         if self.compiled:
             self.Cg = np.ascontiguousarray(self.Cg, np.float64)
             self.v_eval = self.v_rec = np.empty(0)
@@ -183,11 +186,9 @@ class _Relaxation:
 
     def _evaluate_compiled(self, w: np.ndarray, off: int) -> _Eval | None:
         """:meth:`_evaluate_grid` by the kernel (None: its LAP found no matching)."""
-        from ..kernels import ensure
-        from ..kernels.grid import grid_eval
+        from ..kernels import pick
         args = (self.Cg, np.ascontiguousarray(w), self.na, self.v_eval)
-        ensure(grid_eval, *args)
-        ok, value, chosen, am, gmin, v = grid_eval(*args)
+        ok, value, chosen, am, gmin, v = pick("grid.grid_eval", *args, work=np.inf)(*args)
         if not ok:
             return None
         self.v_eval = v
@@ -196,11 +197,9 @@ class _Relaxation:
         return _Eval(value, chosen * self.m + am[chosen], g, chosen, None, gmin, None, 0.0)
 
     def _recover_compiled(self, chosen: np.ndarray) -> np.ndarray | None:
-        from ..kernels import ensure
-        from ..kernels.grid import grid_recover
+        from ..kernels import pick
         args = (self.Cg, np.ascontiguousarray(chosen, np.int64), self.v_rec)
-        ensure(grid_recover, *args)
-        ok, sel, v = grid_recover(*args)
+        ok, sel, v = pick("grid.grid_recover", *args, work=np.inf)(*args)
         if not ok:
             return None
         self.v_rec = v
