@@ -163,6 +163,7 @@ def test_small_grids_take_numpy_by_default(monkeypatch):
     monkeypatch.delenv("ASSOCOPT_JIT", raising=False)
     monkeypatch.setattr(tiers, "_MODE", [None])
     monkeypatch.setattr(tiers, "_SPENT", {})
+    monkeypatch.setattr(tiers, "loaded", lambda name: None)   # as in a fresh process
     for n, compiled in ((5, False), (12, True)):
         p = AssignmentProblem.dense(np.random.default_rng(n).random((n, n, n)))
         rel = R._Relaxation(p.sizes, p.tuples, p.costs, (0, 1), "auto")
