@@ -38,7 +38,8 @@ def _same(a, b) -> None:
         if va is not None:
             assert va.dtype == vb.dtype and np.array_equal(va, vb), name
     assert a.info == b.info
-    assert set(a.times) == set(b.times)
+    # the first solve of a process also records its back end's import time
+    assert set(a.times) - {"import"} == set(b.times) - {"import"}
 
 
 @st.composite
