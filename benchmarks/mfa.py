@@ -94,12 +94,11 @@ def _same_hypotheses(a: dict, b: dict) -> bool:
     return True
 
 
-def run_config(n: int, window: int, steps: int, seed: int, repeat: int,
-               generation: bool) -> dict:
-    """One scene (``n`` targets, window ``window``): per-step records."""
-    from stonesoup.dataassociator.mfa import MFADataAssociator
+def scene(n: int, window: int, steps: int, seed: int) -> dict:
+    """The parts of one scene (``n`` targets crossing in pairs, window ``window``):
+    the simulated scans, the measurement model, the updater, Stone Soup's
+    hypothesiser and our batched one, the initial tracks and the start time."""
     from stonesoup.gater.distance import DistanceGater
-    from stonesoup.hypothesiser import Hypothesiser
     from stonesoup.hypothesiser.mfa import MFAHypothesiser
     from stonesoup.hypothesiser.probability import PDAHypothesiser
     from stonesoup.measures import Mahalanobis
@@ -107,19 +106,11 @@ def run_config(n: int, window: int, steps: int, seed: int, repeat: int,
     from stonesoup.models.transition.linear import (CombinedLinearGaussianTransitionModel,
                                                     ConstantVelocity)
     from stonesoup.predictor.kalman import KalmanPredictor
-    from stonesoup.types.update import GaussianMixtureUpdate
     from stonesoup.updater.kalman import KalmanUpdater
 
     from assocopt.tracking.scenarios.simulate import CrossingScenario
-    from assocopt.tracking.stonesoup import AssocoptMFA, mfa_reference_cost
-    from assocopt.tracking.stonesoup.scenario import mixture_tracks, scan_detections
+    from assocopt.tracking.stonesoup.scenario import mixture_tracks
     from assocopt.tracking.stonesoup.hypothesiser import LinearGaussianMFAHypothesiser
-
-    class Cached(Hypothesiser):
-        """Serves the hypotheses generated for this step."""
-
-        def hypothesise(self, track, detections, timestamp, **kwargs):
-            return self.table[track]
 
     half = 10.0 * np.sqrt(n)
     sc = CrossingScenario(n_targets=n, n_steps=steps, clutter_rate=0.5 * n, pd=0.9,
@@ -132,13 +123,49 @@ def run_config(n: int, window: int, steps: int, seed: int, repeat: int,
                           clutter_spatial_density=sc.clutter_density, prob_detect=sc.pd,
                           prob_gate=0.99, include_all=True)
     stone = MFAHypothesiser(DistanceGater(pda, Mahalanobis(), GATE))
-    fast = LinearGaussianMFAHypothesiser.from_stonesoup(stone)
-    cached = Cached()
+    start = datetime(2026, 1, 1)
+    return {"scenario": sc, "sim": out, "mm": mm, "updater": updater, "stone": stone,
+            "fast": LinearGaussianMFAHypothesiser.from_stonesoup(stone), "start": start,
+            "tracks": mixture_tracks(out.truth[0], start)}
+
+
+def cached_hypothesiser():
+    """A hypothesiser that serves the table of hypotheses set for the step."""
+    from stonesoup.hypothesiser import Hypothesiser
+
+    class Cached(Hypothesiser):
+        """Serves the hypotheses generated for this step."""
+
+        def hypothesise(self, track, detections, timestamp, **kwargs):
+            return self.table[track]
+
+    return Cached()
+
+
+def advance(assoc: dict, updater) -> None:
+    """Updates every track with its pruned hypotheses (the next step's inputs)."""
+    from stonesoup.types.update import GaussianMixtureUpdate
+    for tr, hyps in assoc.items():
+        tr.append(GaussianMixtureUpdate(
+            components=[updater.update(h) if h else h.prediction for h in hyps],
+            hypothesis=hyps))
+
+
+def run_config(n: int, window: int, steps: int, seed: int, repeat: int,
+               generation: bool) -> dict:
+    """One scene (``n`` targets, window ``window``): per-step records."""
+    from stonesoup.dataassociator.mfa import MFADataAssociator
+
+    from assocopt.tracking.stonesoup import AssocoptMFA, mfa_reference_cost
+    from assocopt.tracking.stonesoup.scenario import scan_detections
+
+    parts = scene(n, window, steps, seed)
+    sc, out, mm, updater = parts["scenario"], parts["sim"], parts["mm"], parts["updater"]
+    stone, fast, start, tracks = parts["stone"], parts["fast"], parts["start"], parts["tracks"]
+    cached = cached_hypothesiser()
     ours, ref = AssocoptMFA(cached, slide_window=window), \
         MFADataAssociator(cached, slide_window=window)
     dropping = AssocoptMFA(cached, slide_window=window, drop_dominated=True)
-    start = datetime(2026, 1, 1)
-    tracks = mixture_tracks(out.truth[0], start)
     rows = []
     for k, (zs, lab) in enumerate(zip(out.meas, out.labels), start=1):
         t = start + timedelta(seconds=k * sc.dt)
@@ -176,10 +203,7 @@ def run_config(n: int, window: int, steps: int, seed: int, repeat: int,
             1.0, abs(row["ours_cost"]))
         row["same_pruned"] = _tags(a) == _tags(b) if row["theirs_optimal"] else None
         rows.append(row)
-        for tr, hyps in a.items():
-            tr.append(GaussianMixtureUpdate(
-                components=[updater.update(h) if h else h.prediction for h in hyps],
-                hypothesis=hyps))
+        advance(a, updater)
     return {"targets": n, "window": window, "steps": rows}
 
 
