@@ -361,15 +361,23 @@ def render(result: dict) -> str:
     return "\n".join(lines)
 
 
-def main(argv=None) -> dict:
-    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    ap.add_argument("--configs", default=CONFIGS, help="TARGETSxWINDOW,...")
+def scene_arguments(doc: str, configs: str, repeat: int, page: str
+                    ) -> argparse.ArgumentParser:
+    """The command-line options of a benchmark over scenes (configs, steps, seed,
+    repeat, out)."""
+    ap = argparse.ArgumentParser(description=doc.splitlines()[0])
+    ap.add_argument("--configs", default=configs, help="TARGETSxWINDOW,...")
     ap.add_argument("--steps", type=int, default=8)
     ap.add_argument("--seed", type=int, default=0)
-    ap.add_argument("--repeat", type=int, default=2)
+    ap.add_argument("--repeat", type=int, default=repeat)
+    ap.add_argument("--out", default=str(ROOT / "docs" / page))
+    return ap
+
+
+def main(argv=None) -> dict:
+    ap = scene_arguments(__doc__, CONFIGS, 2, "benchmarks-mfa")
     ap.add_argument("--generation", default="20x4",
                     help="scenes whose hypotheses Stone Soup's chain also generates")
-    ap.add_argument("--out", default=str(ROOT / "docs" / "benchmarks-mfa"))
     ap.add_argument("--render", action="store_true", help="only redraw OUT.md from OUT.json")
     args = ap.parse_args(argv)
     out = Path(args.out)

@@ -23,7 +23,6 @@ re-renders the page and checks it against the JSON).
 
 from __future__ import annotations
 
-import argparse
 import json
 import os
 import sys
@@ -37,7 +36,7 @@ ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))
 sys.path.insert(0, str(ROOT / "benchmarks"))
 
-from mfa import advance, cached_hypothesiser, scene  # noqa: E402
+from mfa import advance, cached_hypothesiser, scene, scene_arguments  # noqa: E402
 from stonesoup_assoc import command, machine, write_pages  # noqa: E402
 
 CONFIGS = "5x6,10x5,10x6,20x5,50x4,50x5"
@@ -193,13 +192,8 @@ def render(result: dict) -> str:
 
 
 def main(argv=None) -> dict:
-    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    ap.add_argument("--configs", default=CONFIGS, help="TARGETSxWINDOW,...")
-    ap.add_argument("--steps", type=int, default=8)
-    ap.add_argument("--seed", type=int, default=0)
-    ap.add_argument("--repeat", type=int, default=3)
+    ap = scene_arguments(__doc__, CONFIGS, 3, "benchmarks-mfa-components")
     ap.add_argument("--min-candidates", type=int, default=1000)
-    ap.add_argument("--out", default=str(ROOT / "docs" / "benchmarks-mfa-components"))
     ap.add_argument("--render", action="store_true", help="only redraw OUT.md from OUT.json")
     args = ap.parse_args(argv)
     out = Path(args.out)
