@@ -108,6 +108,15 @@ def test_sparse_validation(sizes, tuples, costs, match):
         AssignmentProblem.sparse(sizes, tuples, costs)
 
 
+@pytest.mark.parametrize("sizes", [(5, 5, 5), (2 ** 40, 2 ** 40, 5)])
+def test_duplicate_reported_as_the_first_in_sorted_order(sizes):
+    # small sizes: found by mixed-radix keys; 2**80 keys overflow: by row-wise unique
+    T = [[3, 1, 2], [1, 4, 4], [3, 1, 2], [1, 4, 4], [2, 0, 1]]
+    with pytest.raises(InvalidProblemError, match=r"duplicate candidate tuple \[1, 4, 4\]"):
+        AssignmentProblem.sparse(sizes, T, np.zeros(5))
+    AssignmentProblem.sparse(sizes, T[1:3] + T[4:], np.zeros(3))     # no duplicate
+
+
 def test_miss_cost_shape_is_checked():
     with pytest.raises(InvalidProblemError, match=r"row_miss must be a scalar or have shape \(2,\)"):
         AssignmentProblem.two_d(np.ones((2, 2)), row_miss=[1.0, 2.0, 3.0])
