@@ -20,6 +20,7 @@ from ..base import Backend, RawResult, SolveOptions, register
 from ..kernels import spent
 from ..twod.lap import LapInfeasibleError
 from .ascent import _State, _ascent
+from .compiled_ascent import _ascent_grid
 from .local_search import _LocalSearch
 from .options import OPTIONS, OPTIONS_EXACT, check_engines
 from .reduction import dominated
@@ -29,6 +30,9 @@ from .window import (_COMPILED_NODES, _CPSAT_BUDGET, _CPSAT_MAX, _PROBE_SEARCH_M
                      _SEARCH_MAX, _SEARCH_NODES, _compiled_search, _cover_search, _cpsat,
                      Outcome, _grow, _has_numba, _has_ortools, _ilp, _uncovered)
 
+#: Dense axial 3-AP grids run the whole ascent compiled (:mod:`.compiled_ascent`);
+#: False: the Python loop with the compiled evaluation (kept for comparisons).
+_COMPILED_ASCENT = True
 #: The exact mode runs the local search only above this many candidates.
 _LS_MIN_K = 2000
 
@@ -89,7 +93,8 @@ class _LagrangianBase(Backend):
             use_ls = p["local_search"] and (not self._exact or problem.n_candidates > _LS_MIN_K)
             ls = _LocalSearch(problem.sizes, problem.tuples, c) if use_ls else None
             probe = self._probe(rel, pos, st, problem) if self._exact else None
-            upad = _ascent(rel, pos[rel.pos], upad, st, p, deadline, self._exact, ls, probe)
+            run = _ascent_grid if rel.compiled and _COMPILED_ASCENT else _ascent
+            upad = run(rel, pos[rel.pos], upad, st, p, deadline, self._exact, ls, probe)
         except LapInfeasibleError as exc:
             times["ascent"] = time.perf_counter() - t0
             if gated:
@@ -232,7 +237,7 @@ class _LagrangianBase(Backend):
             cap = st.ub if closed else T          # only solutions below cap matter
             leave = skip.may_skip(closed, st.integer, lb, n_in, T)
             status, z, how = self._window(problem, win, red_of, base, lo, cap, closed,
-                                          st, p, options, deadline, rec, leave)
+                                          st, p, options, deadline, rec, leave, skip.retry)
             rec["result"], rec["solver"] = status.value, how
             if status is Outcome.GAVE_UP:     # a larger window holds this one
                 skip.gave_up(T)
@@ -270,8 +275,11 @@ class _LagrangianBase(Backend):
     def _window(problem: AssignmentProblem, win: np.ndarray, red_of: np.ndarray, base: float,
                 lo: float, cap: float, closed: bool, st: _State, p: dict[str, Any],
                 options: SolveOptions, deadline: float | None, rec: dict[str, Any],
-                skip: bool = False) -> tuple[Outcome, float | None, str]:
-        """Best solution among the candidates ``win`` costing less than ``cap``.
+                skip: bool = False, searched: bool = False
+                ) -> tuple[Outcome, float | None, str]:
+        """Best solution among the candidates ``win`` costing less than ``cap``
+        (``searched``: the compiled search gave up on this window before, so the
+        engines take it without a search).
 
         Returns ``(outcome, objective, engine)``, the outcome in the engines' common
         terms (:class:`~.window.Outcome`); HiGHS's own status, when HiGHS ran, goes
@@ -281,8 +289,9 @@ class _LagrangianBase(Backend):
         skip = skip and compiled
         split = compiled and len(win) >= _SPLIT_MIN and bool((problem.tuples[win] == 0).any())
         args = (problem, win, red_of[win], base, cap, st, compiled, _SEARCH_MAX, _SEARCH_NODES)
-        found = _search(*args, _OPEN_NODES if skip or split else _COMPILED_NODES)
-        if found is None and split:     # its components, or (connected) the full search
+        found = None if searched and compiled else \
+            _search(*args, _OPEN_NODES if skip or split else _COMPILED_NODES)
+        if found is None and split and not searched:  # components, or (connected) search
             found = _by_components(problem, win, st, options, deadline) or \
                 (None if skip else _search(*args, _COMPILED_NODES))
         if found is not None:
