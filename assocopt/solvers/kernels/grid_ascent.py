@@ -104,12 +104,57 @@ def grid_eval_sorted(Cs, Is, w, n, v0):
 
 
 @njit(cache=True)
+def grid_local_search(Cg, n, sel, max_sweeps, opt_tol):
+    """Axis-wise re-assignment of the solution ``sel`` of a square grid (``Cg``
+    (n*n, n); candidate ``(i * n + j) * n + k`` is the triple ``(i, j, k)``): per axis
+    the triples with that axis blanked get its indices back by a square LAP, axes in
+    turn until none improves (the moves of
+    :class:`assocopt.solvers.lagrangian.local_search._LocalSearch`, whose
+    neighbourhood on a dense grid this is).  Returns the solution, sorted."""
+    tri = np.empty((n, 3), np.int64)
+    for t in range(n):
+        r = sel[t]
+        tri[t, 0] = r // (n * n)
+        tri[t, 1] = (r // n) % n
+        tri[t, 2] = r % n
+    cost = 0.0
+    for t in range(n):
+        cost += Cg.flat[sel[t]]
+    M = np.empty((n, n))
+    stale = 0
+    s = 0
+    for _ in range(max_sweeps * 3):
+        for t in range(n):
+            for x in range(n):
+                i = x if s == 0 else tri[t, 0]
+                j = x if s == 1 else tri[t, 1]
+                k = x if s == 2 else tri[t, 2]
+                M[t, x] = Cg[i * n + j, k]
+        ok, col, _, _, nc = hungarian_warm(M, np.empty(0))
+        if ok and nc < cost - opt_tol * max(1.0, abs(cost)):
+            for t in range(n):
+                tri[t, s] = col[t]
+            cost = nc
+            stale = 0
+        else:
+            stale += 1
+        if stale >= 3:
+            break
+        s = (s + 1) % 3
+    out = np.empty(n, np.int64)
+    for t in range(n):
+        out[t] = (tri[t, 0] * n + tri[t, 1]) * n + tri[t, 2]
+    return np.sort(out)
+
+
+@njit(cache=True)
 def ascent_block(Cg, Cs, Is, n, w, best_w, d_prev, g, sel, win, hist, v_eval, v_rec, last,
                  si, sf, pi, pf):
     """Iterations of the ascent from the state ``si``/``sf`` until an event, which is
     returned (and left in ``si[SI_EVENT]``).  ``w``: the multipliers of the relaxed
     axis, updated in place; ``best_w`` the best so far; ``sel``: the relaxed solution
-    (event ZERO) or the recovered one (event OFFER); ``win``: the best bounds the
+    (event ZERO) or the recovered one (event OFFER: improved by
+    :func:`grid_local_search` when ``si[SI_LS]``, its cost before in ``sf[SF_COST]``); ``win``: the best bounds the
     stall rule looks back on; ``hist`` (3, max_iter): per iteration ``L``, best ``L``
     and incumbent value, when ``pi[PI_HISTORY]``; ``last``: the pairs last recovered
     (the same pairs again: the same solution, not recovered again)."""
@@ -165,7 +210,10 @@ def ascent_block(Cg, Cs, Is, n, w, best_w, d_prev, g, sel, win, hist, v_eval, v_
                         cost += Cg.flat[s[i]]
                     ub = sf[SF_UB]
                     ls = pi[PI_LS] != 0 and cost < sf[SF_BEST_REC] and it >= si[SI_NEXT_LS]
-                    if ls or cost < ub - 1e-12 * max(1.0, abs(ub)):
+                    if ls:
+                        s = grid_local_search(Cg, n, s, 20, opt_tol)
+                    if ls or cost < ub - (1e-12 * max(1.0, abs(ub)) if np.isfinite(ub)
+                                          else 0.0):
                         sel[:] = s
                         sf[SF_COST] = cost
                         si[SI_LS] = 1 if ls else 0

@@ -20,7 +20,7 @@ from ..base import Backend, RawResult, SolveOptions, register
 from ..kernels import spent
 from ..twod.lap import LapInfeasibleError
 from .ascent import _State, _ascent
-from .compiled_ascent import _ascent_grid
+from .compiled_ascent import _ascent_grid, applies
 from .local_search import _LocalSearch
 from .options import OPTIONS, OPTIONS_EXACT, check_engines
 from .reduction import dominated
@@ -93,7 +93,7 @@ class _LagrangianBase(Backend):
             use_ls = p["local_search"] and (not self._exact or problem.n_candidates > _LS_MIN_K)
             ls = _LocalSearch(problem.sizes, problem.tuples, c) if use_ls else None
             probe = self._probe(rel, pos, st, problem) if self._exact else None
-            run = _ascent_grid if rel.compiled and _COMPILED_ASCENT else _ascent
+            run = _ascent_grid if _COMPILED_ASCENT and applies(rel) else _ascent
             upad = run(rel, pos[rel.pos], upad, st, p, deadline, self._exact, ls, probe)
         except LapInfeasibleError as exc:
             times["ascent"] = time.perf_counter() - t0

@@ -25,6 +25,13 @@ from .relaxation import _Relaxation
 _BLOCK_ENTRIES = 4_000_000
 
 
+def applies(rel: _Relaxation) -> bool:
+    """Whether the compiled ascent runs on ``rel``: a compiled square grid (all three
+    axes of the same size, so that the recovery and the local search are square
+    LAPs)."""
+    return bool(rel.compiled) and rel.m == rel.na
+
+
 def _ascent_grid(rel: _Relaxation, pos: np.ndarray, upad: np.ndarray, st: _State,
                  p: dict[str, Any], deadline: float | None, exact: bool,
                  ls: "_LocalSearch | None" = None, probe: Any = None) -> np.ndarray:
@@ -87,12 +94,10 @@ def _ascent_grid(rel: _Relaxation, pos: np.ndarray, upad: np.ndarray, st: _State
         if event == K.BLOCK_END:
             continue
         if event == K.OFFER:
-            sol = pos[sel]
-            if si[K.SI_LS]:
-                st.best_recovered = float(st.costs[sol].sum())
+            if si[K.SI_LS]:               # a record recovery, improved by the kernel
+                st.best_recovered = float(sf[K.SF_COST])
                 si[K.SI_NEXT_LS] = si[K.SI_IT] + 5
-                sol = ls.improve(sol)
-            st.offer(sol)
+            st.offer(pos[sel])
             continue
         if event == K.PROBE:
             verdict = probe(padded(best_w))
