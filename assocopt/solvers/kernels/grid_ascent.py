@@ -280,3 +280,56 @@ def ascent_block(Cg, Cs, Is, n, w, best_w, d_prev, g, sel, win, hist, v_eval, v_
         si[SI_HAS_D] = 1
         si[SI_IT] = it + 1
         si[SI_STAGE] = 0
+
+
+@njit(cache=True)
+def grid_fixing(Cg, Cs, Is, w, n, v0, max_sweeps):
+    """The fixing bounds of
+    :meth:`assocopt.solvers.lagrangian.relaxation._Relaxation.fixing_bounds` on a
+    square grid, in one pass: the relaxed 2-D problem at ``w`` (as
+    :func:`grid_eval_sorted`), its duals by the shortest-path sweeps of
+    :func:`assocopt.solvers.twod.lap.assignment_duals` (Jacobi, same tolerance), the
+    reduced costs.  Returns ``(ok, lb, red, l_dual)`` in the grid's order."""
+    G, m = Cg.shape
+    ok, _, chosen, _, gmin, _ = grid_eval_sorted(Cs, Is, w, n, v0)
+    lb = np.empty(G * m)
+    red = np.empty(G * m)
+    if not ok:
+        return False, lb, red, np.inf
+    col = np.empty(n, np.int64)
+    for i in range(n):
+        col[i] = chosen[i] - i * n
+    beta = np.zeros(n)
+    best = np.empty(n)
+    for _ in range(max_sweeps):
+        best[:] = np.inf
+        for i in range(n):
+            c = col[i]
+            b0 = beta[c] - gmin[i * n + c]
+            for j in range(n):
+                if j != c:
+                    x = b0 + gmin[i * n + j]
+                    if x < best[j]:
+                        best[j] = x
+        changed = False
+        for j in range(n):
+            if best[j] < beta[j] - 1e-12 * (1.0 + abs(beta[j])):
+                beta[j] = best[j]
+                changed = True
+        if not changed:
+            break
+    alpha = np.empty(n)
+    for i in range(n):
+        a = np.inf
+        for j in range(n):
+            a = min(a, gmin[i * n + j] - beta[j])
+        alpha[i] = a
+    l_dual = alpha.sum() + beta.sum() + w.sum()
+    for i in range(n):
+        for j in range(n):
+            g = i * n + j
+            for k in range(m):
+                r = Cg[g, k] - w[k] - alpha[i] - beta[j]
+                red[g * m + k] = max(r, 0.0)
+                lb[g * m + k] = l_dual + red[g * m + k]
+    return True, lb, red, l_dual

@@ -21,13 +21,14 @@ from ..kernels import spent
 from ..twod.lap import LapInfeasibleError
 from .ascent import _State, _ascent
 from .compiled_ascent import _ascent_grid, applies
+from .fixing import fixing_bounds, make_probe
 from .local_search import _LocalSearch
 from .options import OPTIONS, OPTIONS_EXACT, check_engines
 from .reduction import dominated
 from .relaxation import _Relaxation
 from .policy import _OPEN_NODES, _SPLIT_MIN, _Skipper, _by_components, _search
 from .window import (_COMPILED_NODES, _CPSAT_BUDGET, _CPSAT_MAX, _PROBE_SEARCH_MAX,
-                     _SEARCH_MAX, _SEARCH_NODES, _compiled_search, _cover_search, _cpsat,
+                     _SEARCH_MAX, _SEARCH_NODES, _cpsat,
                      Outcome, _grow, _has_numba, _has_ortools, _ilp, _uncovered)
 
 #: Dense axial 3-AP grids run the whole ascent compiled (:mod:`.compiled_ascent`);
@@ -122,41 +123,9 @@ class _LagrangianBase(Backend):
     def _probe(rel: _Relaxation, pos: np.ndarray, st: _State, problem: AssignmentProblem
                ) -> Callable[[np.ndarray], str | None]:
         """Reduced-cost fixing test run now and then during the ascent (exact mode):
-        stop when it proves the incumbent, or leaves a window small enough to search."""
-        gpos = pos[rel.pos]
-
-        def probe(u: np.ndarray) -> str | None:
-            lb, red, base = rel.fixing_bounds(u)
-            if st.integer:
-                keep = np.ceil(lb - 1e-6) < st.ub
-            else:
-                keep = lb - st.tol() < st.ub
-            inc = np.isin(gpos, st.incumbent)
-            keep &= ~inc
-            n = int(keep.sum())
-            if n == 0:
-                st.proof = "reduced-cost fixing left only the incumbent"
-                st.bound = max(st.bound, st.ub)
-                return "proven"
-            compiled = _has_numba()
-            if n + len(st.incumbent) <= (8 if compiled else 1) * _PROBE_SEARCH_MAX:
-                win = np.union1d(gpos[keep], st.incumbent)
-                red_of = np.full(len(st.costs), np.inf)
-                red_of[gpos] = red
-                if compiled:
-                    sel, complete = _compiled_search(problem, win, red_of[win], base,
-                                                     st.ub, st.integer, 3_000)
-                else:
-                    sel, complete = _cover_search(problem, win, red_of[win], base, st.ub,
-                                                  node_limit=3_000)
-                if complete:
-                    if sel is not None:
-                        st.offer(sel)
-                    st.proof = "search over the candidates left by reduced-cost fixing"
-                    st.bound = max(st.bound, st.ub)
-                    return "proven"
-            return None
-        return probe
+        stop when it proves the incumbent, or leaves a window small enough to search
+        (:func:`.fixing.make_probe`)."""
+        return make_probe(rel, pos, st, problem, _has_numba(), _PROBE_SEARCH_MAX)
 
     def _close_gap(self, problem: AssignmentProblem, rel: _Relaxation, pos: np.ndarray,
                    upad: np.ndarray, st: _State, p: dict[str, Any], options: SolveOptions,
@@ -174,11 +143,11 @@ class _LagrangianBase(Backend):
         CP-SAT or HiGHS (see ``window``).
         """
         t0 = time.perf_counter()
-        lb, red, base = rel.fixing_bounds(upad)
+        lb, red, base = fixing_bounds(rel, upad)
         gpos = pos[rel.pos]
         red_of = np.full(problem.n_candidates, np.inf)
         red_of[gpos] = red
-        order = np.argsort(lb, kind="stable")
+        order = _sort_below(lb, st.ub)
         lb, gpos = lb[order], gpos[order]
         lo = st.bound
         if st.integer:
@@ -373,6 +342,17 @@ class _LagrangianBase(Backend):
             return RawResult(status, message=message, info=info, solve_time=solve_time)
         return RawResult(status, selected=st.incumbent, bound=bound, message=message,
                          info=info, solve_time=solve_time)
+
+
+def _sort_below(lb: np.ndarray, ub: float) -> np.ndarray:
+    """The stable order of ``lb`` as far as windows look (the entries below ``ub``;
+    those at or above it, which no window below the incumbent holds, follow in any
+    order): sorting only those costs a fraction on Grundel n = 50."""
+    below = np.flatnonzero(lb < ub)
+    if len(below) == len(lb):
+        return np.argsort(lb, kind="stable")
+    rest = np.flatnonzero(~(lb < ub))
+    return np.concatenate([below[np.argsort(lb[below], kind="stable")], rest])
 
 
 @register

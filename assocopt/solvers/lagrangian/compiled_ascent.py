@@ -32,6 +32,16 @@ def applies(rel: _Relaxation) -> bool:
     return bool(rel.compiled) and rel.m == rel.na
 
 
+def sorted_rows(rel: _Relaxation) -> tuple[np.ndarray, np.ndarray]:
+    """Each pair's costs in increasing order and their relaxed indices (made once per
+    relaxation), for the kernels' early-stopping minimum over the relaxed axis."""
+    if getattr(rel, "sorted_rows", None) is None:
+        order = np.argsort(rel.Cg, axis=1)
+        rel.sorted_rows = (np.ascontiguousarray(np.take_along_axis(rel.Cg, order, 1)),
+                           order.astype(np.int32))
+    return rel.sorted_rows
+
+
 def _ascent_grid(rel: _Relaxation, pos: np.ndarray, upad: np.ndarray, st: _State,
                  p: dict[str, Any], deadline: float | None, exact: bool,
                  ls: "_LocalSearch | None" = None, probe: Any = None) -> np.ndarray:
@@ -64,11 +74,7 @@ def _ascent_grid(rel: _Relaxation, pos: np.ndarray, upad: np.ndarray, st: _State
     pf = np.array([p["step_decay"], p["step_min"], p["deflect"], p["gap_tol"],
                    p["stall_tol"], OPT_TOL], np.float64)
     block = max(1, int(_BLOCK_ENTRIES // max(rel.K, 1)))
-    if getattr(rel, "sorted_rows", None) is None:
-        order = np.argsort(rel.Cg, axis=1)
-        rel.sorted_rows = (np.ascontiguousarray(np.take_along_axis(rel.Cg, order, 1)),
-                           order.astype(np.int32))
-    Cs, Is = rel.sorted_rows
+    Cs, Is = sorted_rows(rel)
     args = (rel.Cg, Cs, Is, n, w, best_w, d_prev, g, sel, win, hist, v_eval, v_rec,
             np.zeros(n, np.int64), si, sf, pi, pf)
     kernel = pick("grid_ascent.ascent_block", *args, work=math.inf)
