@@ -23,7 +23,7 @@ from .ascent import _State, _ascent
 from .compiled_ascent import _ascent_grid, applies
 from .fixing import fixing_bounds, make_probe
 from .local_search import _LocalSearch
-from .options import OPTIONS, OPTIONS_EXACT, check_engines
+from .options import OPTIONS, OPTIONS_EXACT, check_engines, resolve_defaults
 from .reduction import dominated
 from .relaxation import _Relaxation
 from .policy import _OPEN_NODES, _SPLIT_MIN, _Skipper, _by_components, _search
@@ -59,7 +59,7 @@ class _LagrangianBase(Backend):
         keep = problem.kept_axes(p["keep_axes"])
         c = problem.costs
         integer = problem.integer_costs
-        st = _State(costs=c, integer=integer, theta=p["step0"],
+        st = _State(costs=c, integer=integer,
                     history={"bound": [], "best_bound": [], "objective": []}
                     if p["return_history"] else None)
         times: dict[str, float] = {}
@@ -88,13 +88,16 @@ class _LagrangianBase(Backend):
         try:
             rel = _Relaxation(problem.sizes, problem.tuples[pos], c[pos], keep, p["lap"])
             info["lap_structure"] = "uniform" if rel.uniform else "grouped"
+            compiled = _COMPILED_ASCENT and applies(rel)
+            info["parameters"].update(resolve_defaults(p, compiled))
+            st.theta = p["step0"]
             upad = rel.initial_multipliers() if p["init"] == "share" else np.zeros(rel.u_len)
             # local search pays off on large problems; on small ones the exact mode's
             # fixing and window search settle the incumbent faster without it
             use_ls = p["local_search"] and (not self._exact or problem.n_candidates > _LS_MIN_K)
             ls = _LocalSearch(problem.sizes, problem.tuples, c) if use_ls else None
             probe = self._probe(rel, pos, st, problem) if self._exact else None
-            run = _ascent_grid if _COMPILED_ASCENT and applies(rel) else _ascent
+            run = _ascent_grid if compiled else _ascent
             upad = run(rel, pos[rel.pos], upad, st, p, deadline, self._exact, ls, probe)
         except LapInfeasibleError as exc:
             times["ascent"] = time.perf_counter() - t0
