@@ -249,8 +249,8 @@ def ascent_block(Cg, Cs, Is, n, w, best_w, d_prev, g, sel, win, hist, v_eval, v_
             k = si[SI_NWIN]
             win[k] = best
             si[SI_NWIN] = k + 1
-            s = pi[PI_STALL_ITER]
-            if k + 1 > s and win[k] - win[k - s] < pf[PF_STALL_TOL] * (ub - best):
+            back = pi[PI_STALL_ITER]
+            if k + 1 > back and win[k] - win[k - back] < pf[PF_STALL_TOL] * (ub - best):
                 si[SI_EVENT] = STALLED
                 return STALLED
         if si[SI_SINCE] >= pi[PI_PATIENCE]:

@@ -20,8 +20,9 @@ from .local_search import _LocalSearch
 from .options import OPT_TOL
 from .relaxation import _Relaxation
 
-#: A block of iterations evaluates about this many grid entries (n = 50: 32
-#: iterations, some 6 ms) before the deadline is checked (and Ctrl-C can act).
+#: A block of iterations evaluates at most this many grid entries (n = 50: 32
+#: iterations, some 5 ms) before Python runs again (Ctrl-C can act); with a deadline,
+#: blocks end by it at the pace measured so far, the first after one iteration.
 _BLOCK_ENTRIES = 4_000_000
 
 
@@ -79,6 +80,7 @@ def _ascent_grid(rel: _Relaxation, pos: np.ndarray, upad: np.ndarray, st: _State
             np.zeros(n, np.int64), si, sf, pi, pf)
     kernel = pick("grid_ascent.ascent_block", *args, work=math.inf)
     flushed = 0
+    t0 = time.perf_counter()
 
     def padded(x: np.ndarray) -> np.ndarray:
         u = upad.copy()
@@ -87,10 +89,17 @@ def _ascent_grid(rel: _Relaxation, pos: np.ndarray, upad: np.ndarray, st: _State
 
     while True:
         if si[K.SI_STAGE] == 0 and si[K.SI_IT] >= si[K.SI_END]:
-            if si[K.SI_IT] and deadline is not None and time.perf_counter() > deadline:
-                st.stop = "time_limit"
-                break
-            si[K.SI_END] = si[K.SI_IT] + block
+            step = block
+            if deadline is not None:
+                now = time.perf_counter()
+                if si[K.SI_IT] and now > deadline:
+                    st.stop = "time_limit"
+                    break
+                # a block that ends by the deadline, at the pace so far (first: one)
+                pace = (now - t0) / max(int(si[K.SI_IT]), 1)
+                step = 1 if not si[K.SI_IT] else \
+                    max(1, min(block, int(0.5 * (deadline - now) / max(pace, 1e-9))))
+            si[K.SI_END] = si[K.SI_IT] + step
         sf[K.SF_UB], sf[K.SF_BEST_REC], sf[K.SF_BOUND] = st.ub, st.best_recovered, st.bound
         n_before = int(si[K.SI_EVALS])
         event = kernel(*args)
