@@ -132,9 +132,14 @@ class IndexArithmetic:
 
     @functools.cached_property
     def _covered(self) -> tuple[np.ndarray, ...]:
-        """Sorted distinct real indices each axis's candidates cover."""
+        """Sorted distinct real indices each axis's candidates cover (counted when the
+        axis is not much longer than the candidate list: a sort of a dense 3-AP's
+        125 000 indices per axis cost 2 ms, the count a tenth of that)."""
         T = self.tuples
-        return tuple(np.unique(T[:, s][T[:, s] > 0]) for s in range(len(self.sizes)))
+        K = len(T)
+        return tuple(np.flatnonzero(np.bincount(T[:, s], minlength=n + 1)[1:]) + 1
+                     if n <= 4 * K + 1024 else np.unique(T[:, s][T[:, s] > 0])
+                     for s, n in enumerate(self.sizes))
 
     def axis_index(self, row: int) -> tuple[int, int]:
         """``(axis, real index)`` (index 1-based) of constraint row ``row``."""
