@@ -77,6 +77,10 @@ LIMITS: dict[str, float] = {
     # grid entries of a dense 3-AP; below, the Lagrangian relaxation's numpy route
     # (no plain twin: numpy is quicker than the kernel interpreted)
     "grid.grid_eval": 1_000,
+    # candidates of a gated S-D relaxation (lagrangian.compiled_sparse); below, the
+    # numpy route, as for the grid
+    "sparse_relax.sparse_eval": 5_000,
+    "sparse_relax.sparse_recover": 5_000,
 }
 
 _MODE: list[str | None] = [None]

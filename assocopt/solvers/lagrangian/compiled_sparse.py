@@ -1,0 +1,95 @@
+"""The compiled route of the gated (sparse) Lagrangian relaxation.
+
+:class:`_Relaxation` on a gated problem with dummies (not a dense grid, groups of
+differing tails, ``lap="sparse"``, miss groups present: the tracking scans that
+``auto`` hands to ``lagrangian-exact`` with its tracking options) evaluates ``L(u)``
+and recovers primal solutions by the kernels of
+:mod:`assocopt.solvers.kernels.sparse_relax` instead of about forty numpy calls per
+evaluation and a lexsort plus LAP per relaxed axis per recovery.  The kernels repeat
+the numpy code step for step (the same augmented edge lists, in the same order, to the
+same compiled LAP), so the selections are identical; the sums numpy takes pairwise
+(``L(u)`` itself) are still taken by numpy here, so the values are too.
+
+Used when numba is installed and the candidate set is large enough
+(:data:`assocopt.solvers.kernels.tiers.LIMITS` ``"sparse_relax.sparse_eval"``, or
+the kernel already compiled in this process); else, and for the rare LAP without any
+finite miss cost (numpy hands that one to scipy), the numpy code runs.
+"""
+
+from __future__ import annotations
+
+from typing import Any
+
+import numpy as np
+
+from ..base import module_installed
+from ..twod.lap import Assignment2D, LapInfeasibleError
+
+__all__ = ["sparse_kernels", "SparseKernels"]
+
+EVAL = "sparse_relax.sparse_eval"
+RECOVER = "sparse_relax.sparse_recover"
+
+
+def _i64(a: Any) -> np.ndarray:
+    return np.ascontiguousarray(a, np.int64)
+
+
+def sparse_kernels(rel: Any) -> "SparseKernels | None":
+    """The compiled route for relaxation ``rel``, or None where the numpy code runs
+    (module doc)."""
+    if rel.grid or rel.uniform or rel.lap != "sparse" or not rel.has_miss or rel.K == 0:
+        return None
+    if not module_installed("numba"):
+        return None
+    from ..kernels import tiers
+    if tiers.interpret(EVAL, rel.K, lambda: False):
+        return None                      # small: numpy beats the interpreted kernel
+    return SparseKernels(rel)
+
+
+class SparseKernels:
+    """The kernels' arguments for one relaxation, converted once."""
+
+    def __init__(self, rel: Any):
+        self.nf, self.na, self.nb = int(rel.nf), int(rel.na), int(rel.nb)
+        self.c = np.ascontiguousarray(rel.c, np.float64)
+        self.T = _i64(rel.T)
+        self.relaxed = _i64(rel.relaxed)
+        self.u_off = _i64(rel.u_off)
+        self.sizes = _i64(rel.sizes)
+        self.groups = (_i64(rel.g_start), _i64(rel.g_count))
+        self.lap = (_i64(rel.gkey), self.na, self.nb, _i64(rel.pair_g), _i64(rel.pr),
+                    _i64(rel.pc), _i64(rel.rm_g), _i64(rel.rm_i), _i64(rel.cm_g),
+                    _i64(rel.cm_j))
+
+    def evaluate(self, upad: np.ndarray) -> Any:
+        """``_Relaxation.evaluate`` (an ``_Eval``, reduced costs included), or None:
+        left to the numpy code."""
+        from ..kernels import pick
+        from .relaxation import _Eval
+        upad = np.ascontiguousarray(upad, np.float64)
+        args = (self.c, self.T, self.relaxed, self.u_off, upad, self.nf) + self.groups \
+            + self.lap
+        status, rc, gmin, chosen, sel, neg, g, cor, roc = pick(EVAL, *args,
+                                                               work=np.inf)(*args)
+        if status == 2:
+            return None
+        if status == 1:
+            raise LapInfeasibleError("no perfect matching of the augmented edges")
+        free_value = float(rc[:self.nf][neg].sum())
+        value = float(gmin[chosen].sum()) + free_value + float(upad.sum())
+        return _Eval(value, sel, g, chosen, rc, gmin, Assignment2D(cor, roc, "sparse"),
+                     free_value)
+
+    def recover(self, upad: np.ndarray, chosen: np.ndarray) -> tuple[bool, Any]:
+        """``(True, _Relaxation.recover's answer)``, or ``(False, None)``: left to the
+        numpy code."""
+        from ..kernels import pick
+        args = (self.c, self.T, self.relaxed, self.u_off, self.sizes,
+                np.ascontiguousarray(upad, np.float64), self.nf) + self.groups \
+            + (_i64(chosen),)
+        status, sel = pick(RECOVER, *args, work=np.inf)(*args)
+        if status == 2:
+            return False, None
+        return True, (sel if status == 0 else None)
