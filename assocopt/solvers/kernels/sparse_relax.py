@@ -84,30 +84,30 @@ def _with_misses(n1, n2, rows, cols, w, rm, cm):
     return 0, cor, roc
 
 
-@njit(cache=True, nogil=True)
-def _reduced(c, T, relaxed, u_off, upad, first):
-    """``c - sum_t upad[u_off[t] + T[:, relaxed[t]]]`` over ``t >= first``, the
-    subtractions in numpy's order."""
-    rc = c.copy()
-    for t in range(first, len(relaxed)):
-        r = relaxed[t]
-        o = u_off[t]
-        for k in range(len(c)):
-            rc[k] -= upad[o + T[k, r]]
-    return rc
+@njit(cache=True, nogil=True, inline="always")
+def _reduced(c, U, upad, k, first):
+    """``c[k] - sum_t upad[U[t, k]]`` over ``t >= first``, subtracted in numpy's
+    order (``U[t]``: the multiplier slot of every candidate on relaxed axis ``t``)."""
+    v = c[k]
+    for t in range(first, U.shape[0]):
+        v -= upad[U[t, k]]
+    return v
 
 
 @njit(cache=True, nogil=True)
-def sparse_eval(c, T, relaxed, u_off, upad, nf, g_start, g_count, gkey, na, nb,
+def sparse_eval(c, U, u_off, upad, nf, g_start, g_count, gkey, na, nb,
                 pair_g, pr, pc, rm_g, rm_i, cm_g, cm_j):
-    """``L(u)``'s pieces at multipliers ``upad`` (layout of ``_Relaxation``).
+    """``L(u)``'s pieces at multipliers ``upad`` (layout of ``_Relaxation``; ``U[t]``
+    the multiplier slot of each candidate on relaxed axis ``t``).
 
     Returns ``(status, rc, gmin, chosen, sel, neg, subgradient, col_of_row,
     row_of_col)``: reduced costs, group minima, the chosen groups (matched rows, then
     missed rows, then missed columns), the relaxed solution (each chosen group's first
     minimum, then the negative free candidates ``neg``)."""
-    K = len(c)
-    rc = _reduced(c, T, relaxed, u_off, upad, 0)
+    rc = c.copy()
+    for t in range(U.shape[0]):          # axis by axis: quicker than candidate-major
+        for k in range(len(c)):
+            rc[k] -= upad[U[t, k]]
     G = len(g_start)
     gmin = np.empty(G)
     for g in range(G):
@@ -177,23 +177,49 @@ def sparse_eval(c, T, relaxed, u_off, upad, nf, g_start, g_count, gkey, na, nb,
         ns += 1
     sel = sel[:ns]
     cover = np.zeros(u_len, np.int64)
-    for t in range(len(relaxed)):
-        r = relaxed[t]
-        o = u_off[t]
+    for t in range(U.shape[0]):
         for q in range(ns):
-            cover[o + T[sel[q], r]] += 1
+            cover[U[t, sel[q]]] += 1
     for x in range(u_len):
         g[x] = 1.0 - cover[x]
-    for t in range(len(relaxed)):
+    for t in range(len(u_off)):
         g[u_off[t]] = 0.0
     return 0, rc, gmin, chosen, sel, neg, g, cor, roc
 
 
 @njit(cache=True, nogil=True)
-def sparse_recover(c, T, relaxed, u_off, sizes, upad, nf, g_start, g_count, chosen):
+def _key_order(jr, lab, nj, nl):
+    """A stable order of ``(lab, jr)`` pairs (``jr < nj``, ``lab < nl``): two counting
+    sorts, least significant first (numpy: ``lexsort``)."""
+    m = len(jr)
+    first = np.empty(m, np.int64)
+    cnt = np.zeros(nj + 1, np.int64)
+    for x in range(m):
+        cnt[jr[x] + 1] += 1
+    for j in range(nj):
+        cnt[j + 1] += cnt[j]
+    for x in range(m):
+        first[cnt[jr[x]]] = x
+        cnt[jr[x]] += 1
+    o = np.empty(m, np.int64)
+    cnt = np.zeros(nl + 1, np.int64)
+    for x in range(m):
+        cnt[lab[x] + 1] += 1
+    for q in range(nl):
+        cnt[q + 1] += cnt[q]
+    for y in range(m):
+        x = first[y]
+        o[cnt[lab[x]]] = x
+        cnt[lab[x]] += 1
+    return o
+
+
+@njit(cache=True, nogil=True)
+def sparse_recover(c, U, u_off, sizes, upad, nf, g_start, g_count, chosen):
     """The recursive 2-D recovery from the chosen groups: one assignment with misses
     per relaxed axis, of the current groups against that axis's indices, each edge
-    weighted by its cheapest candidate net of the later axes' multipliers.  Returns
+    weighted by its cheapest candidate net of the later axes' multipliers (``sizes``:
+    the relaxed axes' sizes, ``U`` as in :func:`sparse_eval`).  Returns
     ``(status, sel)``: the feasible solution (sorted positions) when status is 0."""
     G = len(chosen)
     n = nf
@@ -212,23 +238,18 @@ def sparse_recover(c, T, relaxed, u_off, sizes, upad, nf, g_start, g_count, chos
         cand[p] = k
         lab[p] = G
         p += 1
-    R = len(relaxed)
-    for step in range(R):
-        r = relaxed[step]
-        nr = sizes[r]
+    for step in range(U.shape[0]):
+        nr = sizes[step]
         m = len(cand)
         w = np.empty(m)
         jr = np.empty(m, np.int64)
         key = np.empty(m, np.int64)
         for x in range(m):
             k = cand[x]
-            v = c[k]
-            for t in range(step + 1, R):
-                v -= upad[u_off[t] + T[k, relaxed[t]]]
-            w[x] = v
-            jr[x] = T[k, r]
+            w[x] = _reduced(c, U, upad, k, step + 1)
+            jr[x] = U[step, k] - u_off[step]
             key[x] = lab[x] * (nr + 1) + jr[x]
-        o = np.argsort(key, kind="mergesort")
+        o = _key_order(jr, lab, nr + 1, G + 1)
         # edges in key order: the cheapest candidate of each (group, index) pair
         er = np.empty(m, np.int64)
         ec = np.empty(m, np.int64)

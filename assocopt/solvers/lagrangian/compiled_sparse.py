@@ -38,7 +38,8 @@ def _i64(a: Any) -> np.ndarray:
 def sparse_kernels(rel: Any) -> "SparseKernels | None":
     """The compiled route for relaxation ``rel``, or None where the numpy code runs
     (module doc)."""
-    if rel.grid or rel.uniform or rel.lap != "sparse" or not rel.has_miss or rel.K == 0:
+    if rel.grid or rel.uniform or rel.lap != "sparse" or not rel.has_miss or not rel.K \
+            or not rel.relaxed:
         return None
     if not module_installed("numba"):
         return None
@@ -54,25 +55,31 @@ class SparseKernels:
     def __init__(self, rel: Any):
         self.nf, self.na, self.nb = int(rel.nf), int(rel.na), int(rel.nb)
         self.c = np.ascontiguousarray(rel.c, np.float64)
-        self.T = _i64(rel.T)
-        self.relaxed = _i64(rel.relaxed)
+        self.U = _i64(np.stack(rel.uidx))       # multiplier slot, per relaxed axis
         self.u_off = _i64(rel.u_off)
-        self.sizes = _i64(rel.sizes)
+        self.sizes = _i64([rel.sizes[r] for r in rel.relaxed])
         self.groups = (_i64(rel.g_start), _i64(rel.g_count))
         self.lap = (_i64(rel.gkey), self.na, self.nb, _i64(rel.pair_g), _i64(rel.pr),
                     _i64(rel.pc), _i64(rel.rm_g), _i64(rel.rm_i), _i64(rel.cm_g),
                     _i64(rel.cm_j))
+        self.fns: dict[str, Any] = {}
+
+    def _fn(self, name: str, args: tuple) -> Any:
+        """:func:`pick`'s answer, asked once per relaxation: the arguments' types never
+        change within one (the ascent calls hundreds of times, and ``pick`` typing 18
+        arguments cost about as much as a small evaluation)."""
+        if name not in self.fns:
+            from ..kernels import pick
+            self.fns[name] = pick(name, *args, work=np.inf)
+        return self.fns[name]
 
     def evaluate(self, upad: np.ndarray) -> Any:
         """``_Relaxation.evaluate`` (an ``_Eval``, reduced costs included), or None:
         left to the numpy code."""
-        from ..kernels import pick
         from .relaxation import _Eval
         upad = np.ascontiguousarray(upad, np.float64)
-        args = (self.c, self.T, self.relaxed, self.u_off, upad, self.nf) + self.groups \
-            + self.lap
-        status, rc, gmin, chosen, sel, neg, g, cor, roc = pick(EVAL, *args,
-                                                               work=np.inf)(*args)
+        args = (self.c, self.U, self.u_off, upad, self.nf) + self.groups + self.lap
+        status, rc, gmin, chosen, sel, neg, g, cor, roc = self._fn(EVAL, args)(*args)
         if status == 2:
             return None
         if status == 1:
@@ -85,11 +92,10 @@ class SparseKernels:
     def recover(self, upad: np.ndarray, chosen: np.ndarray) -> tuple[bool, Any]:
         """``(True, _Relaxation.recover's answer)``, or ``(False, None)``: left to the
         numpy code."""
-        from ..kernels import pick
-        args = (self.c, self.T, self.relaxed, self.u_off, self.sizes,
+        args = (self.c, self.U, self.u_off, self.sizes,
                 np.ascontiguousarray(upad, np.float64), self.nf) + self.groups \
             + (_i64(chosen),)
-        status, sel = pick(RECOVER, *args, work=np.inf)(*args)
+        status, sel = self._fn(RECOVER, args)(*args)
         if status == 2:
             return False, None
         return True, (sel if status == 0 else None)
