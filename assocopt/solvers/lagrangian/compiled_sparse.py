@@ -35,9 +35,10 @@ def _i64(a: Any) -> np.ndarray:
     return np.ascontiguousarray(a, np.int64)
 
 
-def sparse_kernels(rel: Any) -> "SparseKernels | None":
+def sparse_kernels(rel: Any, result: type) -> "SparseKernels | None":
     """The compiled route for relaxation ``rel``, or None where the numpy code runs
-    (module doc)."""
+    (module doc); ``result`` is the relaxation's evaluation type (``_Eval``: handed
+    in, as the relaxation module imports this one)."""
     if rel.grid or rel.uniform or rel.lap != "sparse" or not rel.has_miss or not rel.K \
             or not rel.relaxed:
         return None
@@ -46,13 +47,14 @@ def sparse_kernels(rel: Any) -> "SparseKernels | None":
     from ..kernels import tiers
     if tiers.interpret(EVAL, rel.K, lambda: False):
         return None                      # small: numpy beats the interpreted kernel
-    return SparseKernels(rel)
+    return SparseKernels(rel, result)
 
 
 class SparseKernels:
     """The kernels' arguments for one relaxation, converted once."""
 
-    def __init__(self, rel: Any):
+    def __init__(self, rel: Any, result: type):
+        self.result = result
         self.nf, self.na, self.nb = int(rel.nf), int(rel.na), int(rel.nb)
         self.c = np.ascontiguousarray(rel.c, np.float64)
         self.U = _i64(np.stack(rel.uidx))       # multiplier slot, per relaxed axis
@@ -76,7 +78,6 @@ class SparseKernels:
     def evaluate(self, upad: np.ndarray) -> Any:
         """``_Relaxation.evaluate`` (an ``_Eval``, reduced costs included), or None:
         left to the numpy code."""
-        from .relaxation import _Eval
         upad = np.ascontiguousarray(upad, np.float64)
         args = (self.c, self.U, self.u_off, upad, self.nf) + self.groups + self.lap
         status, rc, gmin, chosen, sel, neg, g, cor, roc = self._fn(EVAL, args)(*args)
@@ -86,7 +87,7 @@ class SparseKernels:
             raise LapInfeasibleError("no perfect matching of the augmented edges")
         free_value = float(rc[:self.nf][neg].sum())
         value = float(gmin[chosen].sum()) + free_value + float(upad.sum())
-        return _Eval(value, sel, g, chosen, rc, gmin, Assignment2D(cor, roc, "sparse"),
+        return self.result(value, sel, g, chosen, rc, gmin, Assignment2D(cor, roc, "sparse"),
                      free_value)
 
     def recover(self, upad: np.ndarray, chosen: np.ndarray) -> tuple[bool, Any]:

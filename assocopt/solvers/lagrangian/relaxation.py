@@ -139,7 +139,7 @@ class _Relaxation:
         if na * nb <= 4_000_000 and (na * nb <= 40_000 or 8 * len(self.pair_g) >= na * nb):
             self.dense = np.full((na, nb), np.inf)
             self.dense_flat = self.pr * nb + self.pc
-        self.kern = sparse_kernels(self)        # gated scans: compiled, else None
+        self.kern = sparse_kernels(self, _Eval)   # gated scans: compiled, else None
 
     def initial_multipliers(self) -> np.ndarray:
         """Each relaxed index gets the least per-index share ``c_k / (real indices of
