@@ -171,3 +171,16 @@ def test_solves_stay_optimal(seed, N):
         mp.setattr(tiers, "_MODE", ["compiled"])
         sol = solve(p, "lagrangian-exact", **TRACKING_OPTIONS)
     assert_optimal(p, sol)
+
+
+def test_bnb_cap_follows_the_route(monkeypatch):
+    """``auto`` gives ``bnb`` fewer gated candidates where the relaxation runs
+    compiled (there ``lagrangian-exact`` overtakes it sooner)."""
+    from assocopt.solvers.kernels import tiers
+    from assocopt.solving import choice
+    monkeypatch.setattr(tiers, "_MODE", ["compiled"])
+    assert choice.bnb_cap(np.array([True, False])).tolist() == \
+        [choice.BNB_MAX_GATED_COMPILED, choice.BNB_MAX_CANDIDATES]
+    monkeypatch.setattr(tiers, "_MODE", ["interpreted"])
+    assert choice.bnb_cap(np.array([True, False])).tolist() == \
+        [choice.BNB_MAX_GATED, choice.BNB_MAX_CANDIDATES]

@@ -25,7 +25,7 @@ import numpy as np
 from ..base import module_installed
 from ..twod.lap import Assignment2D, LapInfeasibleError
 
-__all__ = ["sparse_kernels", "SparseKernels"]
+__all__ = ["sparse_kernels", "compiled_route", "SparseKernels"]
 
 EVAL = "sparse_relax.sparse_eval"
 RECOVER = "sparse_relax.sparse_recover"
@@ -42,12 +42,19 @@ def sparse_kernels(rel: Any, result: type) -> "SparseKernels | None":
     if rel.grid or rel.uniform or rel.lap != "sparse" or not rel.has_miss or not rel.K \
             or not rel.relaxed:
         return None
-    if not module_installed("numba"):
-        return None
-    from ..kernels import tiers
-    if tiers.interpret(EVAL, rel.K, lambda: False):
+    if not compiled_route(rel.K):
         return None                      # small: numpy beats the interpreted kernel
     return SparseKernels(rel, result)
+
+
+def compiled_route(candidates: float) -> bool:
+    """Whether a gated relaxation of ``candidates`` runs compiled: numba installed
+    and :mod:`assocopt.solvers.kernels.tiers` choosing the kernel (compiled mode, the
+    kernel loaded in this process, or a candidate set above its limit)."""
+    if not module_installed("numba"):
+        return False
+    from ..kernels import tiers
+    return not tiers.interpret(EVAL, candidates, lambda: False)
 
 
 class SparseKernels:
