@@ -11,7 +11,7 @@ from ..problems.problem import AssignmentProblem
 from ..solvers.base import module_installed
 
 __all__ = ["choose_solver", "bnb_cap", "BNB_MAX_CANDIDATES", "BNB_MAX_GATED",
-           "BNB_MAX_KEPT"]
+           "BNB_MAX_GATED_COMPILED", "BNB_MAX_KEPT"]
 
 
 #: ``auto`` sends N >= 3 problems with at most this many candidates to ``bnb``
@@ -30,6 +30,13 @@ BNB_MAX_KEPT = 100
 #: about 2,500 candidates by 1.2-12x (5,823 candidates at N = 5: 0.29 s against
 #: 0.023 s), level around 1,500-2,000, ``bnb`` ahead below.
 BNB_MAX_GATED = 2_000
+#: ... lowered to this many where ``lagrangian-exact``'s gated relaxation runs compiled
+#: (:mod:`assocopt.solvers.lagrangian.compiled_sparse`: compiled mode, or its kernels
+#: loaded in this process): there it beat ``bnb`` from about 700-1,000 candidates on
+#: the components of the N = 3-6 scans at spacing 1.5, seeds 41-42 (summed over the
+#: 1,000-2,000-candidate components of N = 4, seed 42: 112 ms against 21 ms; 700-1,000:
+#: 10.6 against 6.6 ms; 500-700: 6.1 against 6.9 ms, ``bnb`` ahead below).
+BNB_MAX_GATED_COMPILED = 700
 
 
 def choose_solver(problem: AssignmentProblem, relax: str | None = None) -> str:
@@ -50,8 +57,21 @@ def choose_solver(problem: AssignmentProblem, relax: str | None = None) -> str:
 
 def bnb_cap(gated):
     """The most candidates ``auto`` gives ``bnb``: :data:`BNB_MAX_GATED` for a problem
-    (or, elementwise, component) with dummies, else :data:`BNB_MAX_CANDIDATES`."""
-    return np.where(gated, BNB_MAX_GATED, BNB_MAX_CANDIDATES)
+    (or, elementwise, component) with dummies (at most :data:`BNB_MAX_GATED_COMPILED`
+    where the gated relaxation runs compiled), else :data:`BNB_MAX_CANDIDATES`."""
+    cap = BNB_MAX_GATED
+    if np.any(gated) and _sparse_relaxation_compiled(cap):
+        cap = min(cap, BNB_MAX_GATED_COMPILED)
+    return np.where(gated, cap, BNB_MAX_CANDIDATES)
+
+
+def _sparse_relaxation_compiled(candidates: int) -> bool:
+    """``compiled_sparse.compiled_route`` without importing the Lagrangian package
+    (a first small solve never loads it): numba installed and the tier rule choosing
+    the gated relaxation's kernel."""
+    from ..solvers.kernels import tiers
+    return _numba_installed() and not tiers.interpret("sparse_relax.sparse_eval",
+                                                      candidates, lambda: False)
 
 
 def _bnb_usable(problem: AssignmentProblem) -> bool:

@@ -18,6 +18,7 @@ from ...problems.problem import AssignmentProblem
 from ..base import module_installed
 from ..twod.lap import (Assignment2D, LapInfeasibleError, assign_with_misses, assignment_duals,
                    linear_assignment)
+from .compiled_sparse import sparse_kernels
 
 
 def _numba_installed(work: float = 0.0) -> bool:
@@ -138,6 +139,7 @@ class _Relaxation:
         if na * nb <= 4_000_000 and (na * nb <= 40_000 or 8 * len(self.pair_g) >= na * nb):
             self.dense = np.full((na, nb), np.inf)
             self.dense_flat = self.pr * nb + self.pc
+        self.kern = sparse_kernels(self, _Eval)   # gated scans: compiled, else None
 
     def initial_multipliers(self) -> np.ndarray:
         """Each relaxed index gets the least per-index share ``c_k / (real indices of
@@ -210,6 +212,8 @@ class _Relaxation:
             return self._evaluate_grid(upad, full_rc)
         nf = self.nf
         rc = None
+        if self.kern is not None and (ev := self.kern.evaluate(upad)) is not None:
+            return ev
         if self.uniform and not full_rc:
             w = np.zeros(self.m)
             for ti in self.tail_idx:
@@ -239,9 +243,7 @@ class _Relaxation:
         asg = assign_with_misses(self.na, self.nb, self.pr, self.pc, pw, rm, cm,
                                  method=self.lap, dense=dense)
         cor, roc = asg.col_of_row, asg.row_of_col
-        i = np.arange(self.na)
-        j = np.arange(self.nb)
-        w = self.nb + 1
+        i, j, w = np.arange(self.na), np.arange(self.nb), self.nb + 1
         keys = np.concatenate([(i[cor >= 0] + 1) * w + cor[cor >= 0] + 1,
                                (i[cor < 0] + 1) * w, j[roc < 0] + 1])
         chosen = np.searchsorted(self.gkey, keys)
@@ -277,6 +279,8 @@ class _Relaxation:
                 except LapInfeasibleError:
                     return None
                 return np.sort(chosen[r] * self.m + c)
+        if self.kern is not None and (out := self.kern.recover(upad, chosen))[0]:
+            return out[1]
         if self.uniform:
             cand = (self.nf + chosen[:, None] * self.m + np.arange(self.m)).ravel()
             lab = np.repeat(np.arange(len(chosen)), self.m)
@@ -316,10 +320,8 @@ class _Relaxation:
             null = G + len(new_cols)
             lab_of_col[0] = null
             real = lab < G
-            if G:
-                keep_real = real & (jr == jg[np.minimum(lab, G - 1)])
-            else:
-                keep_real = np.zeros(len(lab), bool)
+            keep_real = real & (jr == jg[np.minimum(lab, G - 1)]) if G else \
+                np.zeros(len(lab), bool)
             lab_null = lab_of_col[jr]          # -1: column taken by a group
             new_lab = np.where(real, lab, lab_null)
             keep = keep_real | (~real & (lab_null >= 0))
@@ -341,8 +343,7 @@ class _Relaxation:
         ev = self.evaluate(upad, full_rc=True)
         rc, gmin = ev.rc, ev.gmin
         na, nb = self.na, self.nb
-        cor = ev.assignment.col_of_row
-        roc = ev.assignment.row_of_col
+        cor, roc = ev.assignment.col_of_row, ev.assignment.row_of_col
         pw = gmin[self.pair_g]
         if not self.has_miss:
             size = na
@@ -354,8 +355,7 @@ class _Relaxation:
             ec = np.concatenate([self.pc, nb + self.rm_i, self.cm_j, nb + self.pr])
             ew = np.concatenate([pw, gmin[self.rm_g], gmin[self.cm_g], np.zeros(len(pw))])
             match = np.empty(size, np.int64)
-            i = np.arange(na)
-            j = np.arange(nb)
+            i, j = np.arange(na), np.arange(nb)
             match[:na] = np.where(cor >= 0, cor, nb + i)
             match[na:] = np.where(roc >= 0, nb + roc, j)
         alpha, beta = assignment_duals(size, er, ec, ew, match, max_sweeps=max(50, size))
