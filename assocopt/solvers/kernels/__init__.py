@@ -1,6 +1,8 @@
 """numba kernels of the ``bnb`` back end (its N = 3 recovery on gated problems:
 :mod:`.recovery`), the compiled window search of ``lagrangian-exact``, the dominance
-rule of both Lagrangian back ends (:mod:`.dominance`), the sparse 2-D LAP
+rule of both Lagrangian back ends (:mod:`.dominance`), their relaxation of a gated
+problem (:mod:`.sparse_relax`, wired by :mod:`assocopt.solvers.lagrangian.compiled_sparse`;
+the relaxed dense grid: :mod:`.grid`), the sparse 2-D LAP
 (:mod:`.sparse_lap`, imported by :mod:`assocopt.solvers.twod.sparse`) and the 2-D ranking
 of :func:`assocopt.kbest` (:mod:`.sap`: a warm-startable shortest-augmenting-path LAP
 on dense matrices, :mod:`.murty2d`: Murty's method on it, imported by
