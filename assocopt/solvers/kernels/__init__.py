@@ -1,6 +1,8 @@
 """numba kernels of the ``bnb`` back end (its N = 3 recovery on gated problems:
 :mod:`.recovery`), the compiled window search of ``lagrangian-exact``, the dominance
-rule of both Lagrangian back ends (:mod:`.dominance`), the sparse 2-D LAP
+rule of both Lagrangian back ends (:mod:`.dominance`), their relaxation of a gated
+problem (:mod:`.sparse_relax`, wired by :mod:`assocopt.solvers.lagrangian.compiled_sparse`;
+the relaxed dense grid: :mod:`.grid`), the sparse 2-D LAP
 (:mod:`.sparse_lap`, imported by :mod:`assocopt.solvers.twod.sparse`) and the 2-D ranking
 of :func:`assocopt.kbest` (:mod:`.sap`: a warm-startable shortest-augmenting-path LAP
 on dense matrices, :mod:`.murty2d`: Murty's method on it, imported by
@@ -16,7 +18,8 @@ of compiling it (:mod:`.tiers`).
 
 numba's disk cache does not notice a change in a kernel another file calls: after
 editing ``sap.py``, delete ``__pycache__/murty2d.*.nb[ic]`` (the same holds for
-``driver.py`` and the kernels it calls).
+``driver.py`` and the kernels it calls, and for ``sparse_lap.py``, which
+``sparse_relax.py`` calls).
 
 This package file itself imports no numba: it holds the clock of compilation and
 cache loading (:func:`ensure`, :func:`spent`), which :func:`assocopt.solve` reads
