@@ -58,7 +58,8 @@ QUICK = [(3, 100, 2.0, 0.2), (4, 50, 2.0, 0.2), (5, 30, 2.0, 0.2), (3, 60, 0.7, 
 #: targets are checked on them too.  (N, n, spacing, clutter, pd)
 UNSEEN = [(3, 400, 1.5, 0.3, 0.8), (4, 200, 2.5, 0.1, 0.95), (6, 60, 2.0, 0.4, 0.9),
           (3, 150, 0.5, 0.2, 0.9), (5, 120, 1.5, 0.2, 0.9)]
-#: Scans found by probing for weak spots after the second round (seeds 41 on): large
+#: Scans found by probing for weak spots after the second round (on seed 41; tuned on
+#: seeds 41-42; the run draws seeds 71 on, used nowhere else): large
 #: components at spacings 0.8-1.5, where `auto` fell to 4-9x of HiGHS at N = 4-5.
 PROBED = [(4, 200, 1.0, 0.2, 0.9), (4, 500, 1.5, 0.2, 0.9), (5, 150, 1.2, 0.2, 0.9),
           (4, 300, 0.8, 0.2, 0.9), (5, 200, 1.0, 0.2, 0.9), (6, 150, 1.2, 0.2, 0.9)]
@@ -204,7 +205,7 @@ def main(argv=None) -> int:
     warm_up()
     rows = []
     plan = [(s + (0.9,), 1) for s in (QUICK if args.quick else SCANS)]
-    plan += [] if args.quick else [(s, 31) for s in UNSEEN] + [(s, 41) for s in PROBED]
+    plan += [] if args.quick else [(s, 31) for s in UNSEEN] + [(s, 71) for s in PROBED]
     for (N, n, spacing, clutter, pd), first in plan:
         for seed in range(first, first + args.seeds):
             spec = ScanSpec(N, n, spacing=spacing, clutter=clutter, pd=pd, seed=seed)
