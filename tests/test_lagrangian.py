@@ -295,6 +295,7 @@ def test_parameters_are_recorded():
 def test_auto_picks_lagrangian_exact_for_large_three_or_more_axes(monkeypatch):
     import assocopt.solving.choice as api
     monkeypatch.setattr(api, "BNB_MAX_CANDIDATES", 10)
+    monkeypatch.setattr(api, "BNB_MAX_GRID", 10)                # dense square grids
     assert choose_solver(_rand3(3)) == "lagrangian-exact"       # 27 candidates
     assert choose_solver(AssignmentProblem.dense(np.ones((3, 3)))) == "scipy-lsa"
     assert choose_solver(_rand3(3), relax="lp") == "highs"

@@ -57,6 +57,7 @@ def test_compiled_ascent_equals_brute_force(seed, compiled):
     sol = solve(p, "lagrangian-exact")
     assert sol.info["parameters"]["step0"] == 0.5          # the grid's defaults ran
     assert sol.info["parameters"]["recover_every"] == 3
+    assert sol.info["parameters"]["patience"] == 7 and sol.info["parameters"]["stall_tol"] == 3e-3
     assert_optimal(p, sol)
     assert sol.objective == pytest.approx(_brute(C), abs=1e-9)
 
@@ -190,3 +191,18 @@ def test_public_instances_proven_at_the_recorded_optimum(name, ap_instances, com
     assert sol.status is Status.OPTIMAL
     assert sol.objective == float(known_value(path))
     assert_optimal(p, sol)
+
+
+def test_auto_sends_square_grids_above_the_grid_cap_to_lagrangian_exact():
+    """Dense square 3-D grids above ``BNB_MAX_GRID`` candidates go to the compiled
+    ascent; at or below it, and non-square problems up to ``BNB_MAX_CANDIDATES``,
+    to ``bnb`` as before."""
+    from assocopt.solving.choice import BNB_MAX_GRID, choose_solver
+    rng = np.random.default_rng(0)
+    n = int(np.floor(BNB_MAX_GRID ** (1 / 3)))
+    assert choose_solver(AssignmentProblem.dense(rng.random((n, n, n)))) == "bnb"
+    assert choose_solver(AssignmentProblem.dense(rng.random((n + 1,) * 3))) == \
+        "lagrangian-exact"
+    full = AssignmentProblem.dense(rng.random((n + 1,) * 3))          # one triple less
+    holed = AssignmentProblem.sparse(full.sizes, full.tuples[1:], full.costs[1:])
+    assert choose_solver(holed) == "bnb"

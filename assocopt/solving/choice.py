@@ -11,7 +11,7 @@ from ..problems.problem import AssignmentProblem
 from ..solvers.base import module_installed
 
 __all__ = ["choose_solver", "bnb_cap", "BNB_MAX_CANDIDATES", "BNB_MAX_GATED",
-           "BNB_MAX_GATED_COMPILED", "BNB_MAX_KEPT"]
+           "BNB_MAX_GATED_COMPILED", "BNB_MAX_KEPT", "BNB_MAX_GRID"]
 
 
 #: ``auto`` sends N >= 3 problems with at most this many candidates to ``bnb``
@@ -19,6 +19,12 @@ __all__ = ["choose_solver", "bnb_cap", "BNB_MAX_CANDIDATES", "BNB_MAX_GATED",
 #: ``lagrangian-exact`` up to Grundel n = 20 (8,000 candidates), slower at n = 30
 #: (docs/benchmarks-sd.md).
 BNB_MAX_CANDIDATES = 10_000
+#: ... but dense square 3-D grids (axial 3-AP) with more candidates than this go to
+#: ``lagrangian-exact``, whose ascent runs there as one compiled kernel
+#: (:mod:`assocopt.solvers.lagrangian.compiled_ascent`): measured on the public
+#: instances, Grundel n = 20 (8,000 candidates) 0.032 s against 0.156 s for ten,
+#: Balas-Saltzman n = 16-20 (4,096-8,000) 1.5-2.5 times faster, level at n = 12-14.
+BNB_MAX_GRID = 3_000
 #: ... and with at most this many real indices on the two kept axes: ``bnb``'s dense
 #: Hungarian costs O((n_a + n_b)^3) per iteration, ``lagrangian-exact``'s sparse LAP
 #: far less on large sparse problems.
@@ -35,7 +41,10 @@ BNB_MAX_GATED = 2_000
 #: loaded in this process): there it beat ``bnb`` from about 700-1,000 candidates on
 #: the components of the N = 3-6 scans at spacing 1.5, seeds 41-42 (summed over the
 #: 1,000-2,000-candidate components of N = 4, seed 42: 112 ms against 21 ms; 700-1,000:
-#: 10.6 against 6.6 ms; 500-700: 6.1 against 6.9 ms, ``bnb`` ahead below).
+#: 10.6 against 6.6 ms; 500-700: 6.1 against 6.9 ms, ``bnb`` ahead below); checked on
+#: the components of every setting's seed 51 (not tuned on): 700-1,000 candidates
+#: 25.6 ms against 15.1 (9 components), 1,000-1,500: 69.3 against 24.3 (13), 500-700:
+#: 18.0 against 15.9 (10), ``bnb`` ahead below 500 (201 of 201 components).
 BNB_MAX_GATED_COMPILED = 700
 
 
@@ -49,10 +58,17 @@ def choose_solver(problem: AssignmentProblem, relax: str | None = None) -> str:
         return "highs"
     if problem.ndim == 2:
         return "scipy-lsa"
-    if problem.n_candidates <= bnb_cap((problem.tuples == 0).any()) and \
-            _bnb_usable(problem):
+    gated = bool((problem.tuples == 0).any())
+    cap = bnb_cap(gated) if gated or not _square_grid(problem) else BNB_MAX_GRID
+    if problem.n_candidates <= cap and _bnb_usable(problem):
         return "bnb"
     return "lagrangian-exact"
+
+
+def _square_grid(problem: AssignmentProblem) -> bool:
+    """Every triple of three equal axes (a dense axial 3-AP)."""
+    s = problem.sizes
+    return len(s) == 3 and s[0] == s[1] == s[2] and problem.n_candidates == s[0] ** 3
 
 
 def bnb_cap(gated):

@@ -58,7 +58,10 @@ and the scale at which the ascent stops;  ``deflect`` (0.5): momentum of the
 previous direction;  ``init`` ("share" or "zero"): starting multipliers;
 ``stall_iter`` (60), ``stall_tol`` (1e-3): exact mode leaves the ascent when the bound
 gained less than ``stall_tol`` of the gap in ``stall_iter`` iterations;
-``recover_every`` (1): primal recovery every k iterations (0: never);
+``recover_every`` (1): primal recovery every k iterations (0: never).  On dense
+square 3-D grids, whose ascent runs compiled (:mod:`.compiled_ascent`), ``step0``,
+``recover_every``, ``patience`` and ``stall_tol`` default to 0.5, 3, 7 and 3e-3
+(:data:`.options.GRID_DEFAULTS`);
 ``local_search`` (True; the exact mode uses it above 2,000 candidates);
 ``keep_axes`` (None: the two largest axes);  ``lap`` ("auto", "scipy", "lapx",
 "sparse"): 2-D engine;  ``reduce`` (True): dominance rule;  ``gate`` (None);
@@ -73,7 +76,9 @@ Modules
 :mod:`.relaxation` (the 2-D subproblem: evaluation, primal recovery, fixing bounds;
 :func:`lagrangian_bound`), :mod:`.local_search` (axis-wise re-assignment),
 :mod:`.reduction` (the dominance rule :func:`dominated`), :mod:`.ascent` (solve
-state and the subgradient ascent), :mod:`.window` (exact search, CP-SAT and HiGHS on
+state and the subgradient ascent), :mod:`.compiled_ascent` (the same ascent on dense
+square 3-D grids, by one kernel), :mod:`.fixing` (reduced-cost fixing bounds, the
+probes of the exact mode), :mod:`.window` (exact search, CP-SAT and HiGHS on
 candidate windows), :mod:`.policy` (windows solved by components, windows left to a
 larger one), :mod:`.backend` (the two registered back ends).
 

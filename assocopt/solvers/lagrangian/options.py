@@ -24,9 +24,12 @@ __all__ = ["OPT_TOL", "OPTIONS", "OPTIONS_EXACT", "check_engines", "resolve_defa
 #: above the bound early on, and the full step overshot: no better bound for the first
 #: 10-20 iterations at n = 50) and a recovery every third iteration (its LAP cost as
 #: much as the evaluation's) took 25-30% off the total; on gated tracking scans (not
-#: grids) the half step doubled the iterations, so it stays 1.0 there.
-GRID_DEFAULTS = {"step0": 0.5, "recover_every": 3}
-OTHER_DEFAULTS = {"step0": 1.0, "recover_every": 1}
+#: grids) the half step doubled the iterations, so it stays 1.0 there.  Then a
+#: patience of 7 and a stall share of 0.003 (the ascent stops sooner once the bound
+#: creeps; the windows make up for the last hundredths): 13 468 -> 9 484 iterations,
+#: 11% less time over the set.
+GRID_DEFAULTS = {"step0": 0.5, "recover_every": 3, "patience": 7, "stall_tol": 3e-3}
+OTHER_DEFAULTS = {"step0": 1.0, "recover_every": 1, "patience": 10, "stall_tol": 1e-3}
 
 
 def resolve_defaults(p: dict[str, Any], grid: bool) -> dict[str, Any]:
@@ -50,8 +53,9 @@ def _options(exact: bool) -> tuple[Option, ...]:
         Option("step_decay", "float", 0.5, "factor applied to the step scale after "
                "`patience` iterations without a better bound", low=0.0, low_open=True,
                high=1.0),
-        Option("patience", "int", 10, "iterations without a better bound before the step "
-               "scale decays", low=1),
+        Option("patience", "int", None, "iterations without a better bound before the "
+               "step scale decays (None: 7 on dense square 3-D grids, else 10)", low=1,
+               nullable=True),
         Option("step_min", "float", 1e-4, "step scale at which the ascent stops", low=0.0),
         Option("deflect", "float", 0.5, "momentum: share of the previous direction kept",
                low=0.0, high=0.99),
@@ -67,8 +71,9 @@ def _options(exact: bool) -> tuple[Option, ...]:
                "objective in info['history']"),
         Option("stall_iter", "int", 60, "exact mode: iterations over which the bound must "
                "gain stall_tol of the gap", low=1),
-        Option("stall_tol", "float", 1e-3, "exact mode: share of the gap the bound must "
-               "gain in stall_iter iterations to go on", low=0.0),
+        Option("stall_tol", "float", None, "exact mode: share of the gap the bound must "
+               "gain in stall_iter iterations to go on (None: 0.003 on dense square 3-D "
+               "grids, else 0.001)", low=0.0, nullable=True),
         Option("local_search", "bool", True, "axis-wise re-assignment of record solutions "
                "(exact mode: above 2,000 candidates)"),
         Option("init", "choice", "share", "starting multipliers", choices=("share", "zero")),
