@@ -23,7 +23,8 @@ Families (every instance is solved by every method in this one process):
   the small problems a Monte Carlo study solves by the thousand.
 
 Methods: ``lagrangian`` (bound + heuristic), ``lagrangian-exact``, ``auto`` (``bnb``,
-the compiled branch and bound, up to 10,000 candidates, else ``lagrangian-exact``),
+the compiled branch and bound, on small problems, else ``lagrangian-exact``: the rule
+of :func:`assocopt.solving.choice.choose_solver`),
 ``highs`` (HiGHS through highspy), ``scipy`` (scipy.optimize.milp), ``ortools-cpsat``.  Reported: time
 to a proven optimum (per-solve time limit), the gap after a fixed time, the plain
 Lagrangian's gap after 100 iterations, the in-process latency of ``solver="auto"`` on
@@ -61,7 +62,7 @@ from assocopt.testing import random_scans  # noqa: E402
 
 PEERS = ("highs", "scipy", "ortools-cpsat")
 #: our exact methods, run on every instance: the one the user gets by default
-#: (``auto``: ``bnb`` up to 10,000 candidates, else ``lagrangian-exact``) and the
+#: (``auto``: ``bnb`` on small problems, else ``lagrangian-exact``) and the
 #: Lagrangian exact method alone
 OURS = ("auto", "lagrangian-exact")
 EXACT = OURS + PEERS

@@ -44,7 +44,7 @@ BNB_MAX_GATED = 2_000
 #: 10.6 against 6.6 ms; 500-700: 6.1 against 6.9 ms, ``bnb`` ahead below); checked on
 #: the components of every setting's seed 51 (not tuned on): 700-1,000 candidates
 #: 25.6 ms against 15.1 (9 components), 1,000-1,500: 69.3 against 24.3 (13), 500-700:
-#: 18.0 against 15.9 (10), ``bnb`` ahead below 500 (201 of 201 components).
+#: 18.0 against 15.9 (10), ``bnb`` ahead below 500 (on 200 of 201 components).
 BNB_MAX_GATED_COMPILED = 700
 
 
