@@ -18,8 +18,9 @@ of compiling it (:mod:`.tiers`).
 
 numba's disk cache does not notice a change in a kernel another file calls: after
 editing ``sap.py``, delete ``__pycache__/murty2d.*.nb[ic]`` (the same holds for
-``driver.py`` and the kernels it calls, and for ``sparse_lap.py``, which
-``sparse_relax.py`` calls).
+``driver.py`` and the kernels it calls, for ``sparse_lap.py``, which
+``sparse_relax.py`` calls, and for ``grid.py`` and ``hungarian.py``, which
+``grid_ascent.py`` calls).
 
 This package file itself imports no numba: it holds the clock of compilation and
 cache loading (:func:`ensure`, :func:`spent`), which :func:`assocopt.solve` reads

@@ -38,16 +38,24 @@ def grid_eval(Cg, w, n, v0):
                 k = j
         am[g] = k
         gmin[g] = best
-    D = gmin.reshape(n, n)
-    ok, col, _, v, _ = hungarian_warm(D, v0)
+    ok, value, chosen, v = assign_pairs(gmin, n, w, v0)
+    return ok, value, chosen, am, gmin, v
+
+
+@njit(cache=True)
+def assign_pairs(gmin, n, w, v0):
+    """The 2-D step of ``L(u)``: the square LAP of the pair minima ``gmin`` (n*n,)
+    warm-started from ``v0``, and ``L(u)`` (its value plus the multipliers ``w``).
+    Returns ``(ok, value, chosen, v)``, ``chosen[i] = i * n + j``."""
+    ok, col, _, v, _ = hungarian_warm(gmin.reshape(n, n), v0)
     chosen = np.empty(n, np.int64)
     value = 0.0
     for i in range(n):
         chosen[i] = i * n + col[i]
         value += gmin[chosen[i]]
-    for j in range(m):
+    for j in range(w.shape[0]):
         value += w[j]
-    return ok, value, chosen, am, gmin, v
+    return ok, value, chosen, v
 
 
 @njit(cache=True)

@@ -19,7 +19,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from .grid import grid_recover
+from .grid import assign_pairs, grid_recover
 from .hungarian import hungarian_warm
 from .jit import njit
 
@@ -92,14 +92,7 @@ def grid_eval_sorted(Cs, Is, w, n, v0):
                 k = j
         am[g] = k
         gmin[g] = best
-    ok, col, _, v, _ = hungarian_warm(gmin.reshape(n, n), v0)
-    chosen = np.empty(n, np.int64)
-    value = 0.0
-    for i in range(n):
-        chosen[i] = i * n + col[i]
-        value += gmin[chosen[i]]
-    for j in range(m):
-        value += w[j]
+    ok, value, chosen, v = assign_pairs(gmin, n, w, v0)
     return ok, value, chosen, am, gmin, v
 
 

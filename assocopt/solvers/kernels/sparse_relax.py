@@ -191,27 +191,23 @@ def sparse_eval(c, U, u_off, upad, nf, g_start, g_count, gkey, na, nb,
 def _key_order(jr, lab, nj, nl):
     """A stable order of ``(lab, jr)`` pairs (``jr < nj``, ``lab < nl``): two counting
     sorts, least significant first (numpy: ``lexsort``)."""
-    m = len(jr)
-    first = np.empty(m, np.int64)
-    cnt = np.zeros(nj + 1, np.int64)
-    for x in range(m):
-        cnt[jr[x] + 1] += 1
-    for j in range(nj):
-        cnt[j + 1] += cnt[j]
-    for x in range(m):
-        first[cnt[jr[x]]] = x
-        cnt[jr[x]] += 1
-    o = np.empty(m, np.int64)
-    cnt = np.zeros(nl + 1, np.int64)
-    for x in range(m):
-        cnt[lab[x] + 1] += 1
-    for q in range(nl):
+    return _counting_pass(lab, nl, _counting_pass(jr, nj, np.arange(len(jr))))
+
+
+@njit(cache=True, nogil=True)
+def _counting_pass(key, nk, src):
+    """The positions ``src`` stably sorted by ``key[src]`` (``key < nk``)."""
+    cnt = np.zeros(nk + 1, np.int64)
+    for y in range(len(src)):
+        cnt[key[src[y]] + 1] += 1
+    for q in range(nk):
         cnt[q + 1] += cnt[q]
-    for y in range(m):
-        x = first[y]
-        o[cnt[lab[x]]] = x
-        cnt[lab[x]] += 1
-    return o
+    out = np.empty(len(src), np.int64)
+    for y in range(len(src)):
+        x = src[y]
+        out[cnt[key[x]]] = x
+        cnt[key[x]] += 1
+    return out
 
 
 @njit(cache=True, nogil=True)
