@@ -15,7 +15,7 @@ from typing import Any
 
 import numpy as np
 
-from .ascent import _State
+from .ascent import _State, _record
 from .local_search import _LocalSearch
 from .options import OPT_TOL
 from .relaxation import _Relaxation
@@ -126,10 +126,7 @@ def _ascent_grid(rel: _Relaxation, pos: np.ndarray, upad: np.ndarray, st: _State
             st.bound = max(st.bound, min(L, st.ub))
             st.proof = st.proof or "relaxed solution feasible (zero subgradient)"
             st.stop = "proven"
-            if st.history is not None:
-                st.history["bound"].append(L)
-                st.history["best_bound"].append(float(sf[K.SF_BEST]))
-                st.history["objective"].append(st.ub if math.isfinite(st.ub) else None)
+            _record(st, L, float(sf[K.SF_BEST]))
             _keep_warm(rel, v_eval, v_rec, si, K)
             st.theta = float(sf[K.SF_THETA])
             return padded(w)
