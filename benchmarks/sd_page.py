@@ -223,7 +223,7 @@ _COMPARED = [
     "the relaxed axis on pre-sorted pair rows, Hungarian method warm-started from "
     "the last iteration's potentials, recovery, axis-wise local search, step and "
     "stall rules: step 0.5, recovery every 3rd iteration, patience 7, stall "
-    "tolerance 0.003 there), as are the fixing bounds; on gated problems the "
+    "tolerance 0.1 there), as are the fixing bounds; on gated problems the "
     "evaluation and the recursive recovery are compiled.  Proven optimum, no "
     "tolerance beyond floating-point round-off.",
     "- `auto`: what `solve(p)` picks: `bnb` up to 10,000 candidates (3,000 on dense "

@@ -25,10 +25,13 @@ __all__ = ["OPT_TOL", "OPTIONS", "OPTIONS_EXACT", "check_engines", "resolve_defa
 #: 10-20 iterations at n = 50) and a recovery every third iteration (its LAP cost as
 #: much as the evaluation's) took 25-30% off the total; on gated tracking scans (not
 #: grids) the half step doubled the iterations, so it stays 1.0 there.  Then a
-#: patience of 7 and a stall share of 0.003 (the ascent stops sooner once the bound
-#: creeps; the windows make up for the last hundredths): 13 468 -> 9 484 iterations,
-#: 11% less time over the set.
-GRID_DEFAULTS = {"step0": 0.5, "recover_every": 3, "patience": 7, "stall_tol": 3e-3}
+#: patience of 7 and a stall share of 0.1 (the ascent stops once the bound gains less
+#: than a tenth of the gap in ``stall_iter`` iterations: with integer costs the bound
+#: reaches its final ceiling after 25-75 of 150-210 iterations at n = 50, and the
+#: windows make up for the last hundredths).  The share was 0.003 until it was tuned
+#: on Grundel n = 30-40 and Balas-Saltzman n = 20-26 (0.82 -> 0.62-0.76 s for the 40,
+#: noisy) and checked on Grundel n = 50, not tuned on (0.80-0.91 -> 0.53 s).
+GRID_DEFAULTS = {"step0": 0.5, "recover_every": 3, "patience": 7, "stall_tol": 0.1}
 OTHER_DEFAULTS = {"step0": 1.0, "recover_every": 1, "patience": 10, "stall_tol": 1e-3}
 
 
@@ -72,7 +75,7 @@ def _options(exact: bool) -> tuple[Option, ...]:
         Option("stall_iter", "int", 60, "exact mode: iterations over which the bound must "
                "gain stall_tol of the gap", low=1),
         Option("stall_tol", "float", None, "exact mode: share of the gap the bound must "
-               "gain in stall_iter iterations to go on (None: 0.003 on dense square 3-D "
+               "gain in stall_iter iterations to go on (None: 0.1 on dense square 3-D "
                "grids, else 0.001)", low=0.0, nullable=True),
         Option("local_search", "bool", True, "axis-wise re-assignment of record solutions "
                "(exact mode: above 2,000 candidates)"),
