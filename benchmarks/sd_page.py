@@ -201,6 +201,14 @@ def plot(data: dict, path: Path) -> bool:
 
 
 # ----------------------------------------------------------------------- page
+def _grid_rules() -> str:
+    """The dense-grid ascent defaults, in words (from the solver's own table)."""
+    from assocopt.solvers.lagrangian.options import GRID_DEFAULTS as g
+    return (f"step {g['step0']}, recovery every {g['recover_every']} iterations, "
+            f"patience {g['patience']}, stall tolerance {g['stall_tol']}")
+
+
+_GRID_RULES = _grid_rules()
 _COMPARED = [
     "## What is compared", "",
     "- `lagrangian`: Lagrangian relaxation of N-2 axes to a 2-D assignment "
@@ -222,8 +230,8 @@ _COMPARED = [
     "axial problems (3-AP) the whole ascent is one compiled kernel (minimum over "
     "the relaxed axis on pre-sorted pair rows, Hungarian method warm-started from "
     "the last iteration's potentials, recovery, axis-wise local search, step and "
-    "stall rules: step 0.5, recovery every 3rd iteration, patience 7, stall "
-    "tolerance 0.1 there), as are the fixing bounds; on gated problems the "
+    "stall rules: " + _GRID_RULES + " there), as are the fixing bounds; on gated "
+    "problems the "
     "evaluation and the recursive recovery are compiled.  Proven optimum, no "
     "tolerance beyond floating-point round-off.",
     "- `auto`: what `solve(p)` picks: `bnb` up to 10,000 candidates (3,000 on dense "
