@@ -26,6 +26,7 @@ pytest.importorskip("numba", reason="the bnb back end needs numba")
 
 from assocopt.solvers.bnb import backend as bnb  # noqa: E402
 from assocopt.solvers.bnb import kernels as kern  # noqa: E402
+from assocopt.solvers.kernels import relaxation as kern_relax  # noqa: E402
 
 
 @given(sd_problems())
@@ -189,6 +190,34 @@ def test_hungarian_warm_start_from_any_potentials(seed, n, forbid):
 def test_hungarian_reports_no_matching():
     A = np.array([[1.0, np.inf], [2.0, np.inf]])
     assert kern.hungarian(A)[0] is False
+
+
+@given(st.integers(0, 2 ** 32 - 1), st.integers(0, 400),
+       st.sampled_from(["uniform", "few values", "mostly zero", "all equal", "huge"]))
+def test_stable_order_is_a_stable_sort(seed, m, kind):
+    """The bucket sort of the search's candidate lists equals numpy's stable sort."""
+    rng = np.random.default_rng(seed)
+    v = {"uniform": rng.random(m + 5), "few values": rng.integers(0, 4, m + 5) * 0.5,
+         "mostly zero": np.where(rng.random(m + 5) < 0.7, 0.0, rng.random(m + 5) ** 8 * 1e6),
+         "all equal": np.full(m + 5, 2.5),
+         "huge": rng.choice([-1e300, 0.0, 1e300], m + 5)}[kind]
+    keep = np.sort(rng.choice(m + 5, size=m, replace=False)).astype(np.int64)
+    assert kern_relax.stable_order(v, keep).tolist() == \
+        keep[np.argsort(v[keep], kind="stable")].tolist()
+
+
+@given(sd_problems(), st.integers(0, 2 ** 32 - 1), st.floats(0.0, 3.0))
+def test_sort_lists_sorts_each_row_by_reduced_cost(p, seed, slack):
+    """Every row's list keeps the candidates under ``slack``, cheapest first, ties by
+    candidate (the search's order), as a per-row stable sort gives."""
+    T = np.ascontiguousarray(p.tuples, np.int64)
+    G, ptr, lst, *_ = kern_relax.prepare(T, p.row_offsets, np.asarray(p.sizes, np.int64),
+                                         np.ascontiguousarray(p.costs, np.float64), 0, 1)
+    rp = np.round(np.random.default_rng(seed).random(p.n_candidates) * 3, 1)
+    sptr, slst = kern_relax.sort_lists(ptr, lst, rp, slack)
+    for e in range(len(ptr) - 1):
+        row = [k for k in lst[ptr[e]:ptr[e + 1]] if rp[k] < slack]
+        assert slst[sptr[e]:sptr[e + 1]].tolist() == sorted(row, key=lambda k: (rp[k], k))
 
 
 @given(sd_problems(), st.integers(0, 2 ** 32 - 1))

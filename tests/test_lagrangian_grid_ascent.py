@@ -206,3 +206,23 @@ def test_auto_sends_square_grids_above_the_grid_cap_to_lagrangian_exact():
     full = AssignmentProblem.dense(rng.random((n + 1,) * 3))          # one triple less
     holed = AssignmentProblem.sparse(full.sizes, full.tuples[1:], full.costs[1:])
     assert choose_solver(holed) == "bnb"
+
+
+@pytest.mark.parametrize("integer", [True, False])
+@pytest.mark.parametrize("ub", [7.0, 40.0, np.inf])
+def test_fixing_order_gives_every_window_as_a_prefix(integer, ub):
+    """Each window ``{k : bound_k < T}`` (bounds rounded up for integer costs) is the
+    first ``searchsorted(bounds, T)`` entries of the order, for every threshold up
+    to the incumbent."""
+    from assocopt.solvers.lagrangian.fixing import fixing_order
+    rng = np.random.default_rng(5)
+    lb = rng.normal(10.0, 6.0, 500)
+    lb[:20] = np.round(lb[:20])                      # bounds on whole units, too
+    lo = float(np.ceil(lb.min() + 2.0)) if integer else lb.min() + 2.0
+    bounds, order = fixing_order(lb, lo, ub, integer)
+    assert sorted(order.tolist()) == list(range(len(lb)))
+    assert (np.diff(bounds[bounds < ub]) >= 0).all()
+    key = np.ceil(lb - 1e-6) if integer else lb
+    for T in np.arange(lo + 1.0, min(ub, lo + 30.0) + 1e-9, 1.0 if integer else 0.37):
+        n = int(np.searchsorted(bounds, T, "left"))
+        assert set(order[:n].tolist()) == set(np.flatnonzero(key < T).tolist())

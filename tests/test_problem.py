@@ -79,6 +79,28 @@ def test_uncovered_names_axis_and_index():
     assert p.uncovered() == [(1, 2)]
 
 
+@pytest.mark.parametrize("cached", [False, True])
+def test_window_rows_agree_with_the_cached_rows(cached):
+    """uncovered_rows, coverage_matrix and violations of a subset of the candidates
+    give the same answer whether or not the rows of all candidates are cached."""
+    rng = np.random.default_rng(3)
+    T = np.unique(rng.integers(0, 4, (40, 3)), axis=0)
+    T = T[(T > 0).any(axis=1)]
+    p = AssignmentProblem.sparse((3, 3, 3), T, rng.random(len(T)))
+    if cached:
+        p.entry_rows
+    for pos in (np.arange(p.n_candidates), rng.choice(p.n_candidates, 12, replace=False),
+                np.zeros(0, np.int64)):
+        R = p.rows_of(p.tuples[pos])
+        want = np.setdiff1d(np.arange(p.n_rows), R[R >= 0])
+        assert p.uncovered_rows(pos).tolist() == want.tolist()
+        A = p.coverage_matrix(pos).toarray()
+        assert (A.sum(axis=0) == (R >= 0).sum(axis=1)).all()
+    assert ("entry_rows" in p.__dict__) is cached   # windows need not build the cache
+    sel = np.flatnonzero((p.tuples > 0).sum(axis=1) == 1)
+    assert p.violations(sel[:1]) is not None
+
+
 @pytest.mark.parametrize("bad, match", [
     (np.array([[1.0, np.nan]]), "NaN"),
     (np.array([[1.0, -np.inf]]), "-inf"),

@@ -24,7 +24,7 @@ from .validation import require_memory
 if TYPE_CHECKING:   # pragma: no cover
     import scipy.sparse as sp
 
-__all__ = ["OPT_TOL", "IndexArithmetic", "index_label", "kept_axes"]
+__all__ = ["OPT_TOL", "IndexArithmetic", "index_label", "kept_axes", "real_counts"]
 
 #: Relative tolerance of "a bound meets an objective" for non-integer costs
 #: (floating-point round-off): the one tolerance the exact back ends share.
@@ -34,6 +34,22 @@ OPT_TOL = 1e-9
 def index_label(axis: int, index: int) -> str:
     """``"index i of axis s"`` with the conventions spelled out (axis 0-based, index 1-based)."""
     return f"real index {index} (1-based) of axis {axis} (0-based)"
+
+
+def real_counts(tuples: np.ndarray) -> np.ndarray:
+    """How many real (non-dummy) indices each tuple of ``tuples`` (shape (k, N)) has.
+
+    Column by column: ``(T > 0).sum(axis=1)`` reduces along the short axis, five
+    times slower on a dense 3-AP's 125,000 tuples (2 ms).
+
+    >>> real_counts(np.array([[1, 0, 2], [0, 0, 3]])).tolist()
+    [2, 1]
+    """
+    T = np.asarray(tuples)
+    out = np.zeros(len(T), np.int64)
+    for s in range(T.shape[1] if T.ndim == 2 else 0):
+        out += T[:, s] > 0
+    return out
 
 
 def kept_axes(sizes: Sequence[int], keep: Any = None) -> tuple[int, int]:
@@ -89,7 +105,7 @@ class IndexArithmetic:
         """
         import scipy.sparse as sp     # here: importing assocopt need not load scipy
 
-        R = self.entry_rows if pos is None else self.entry_rows[np.asarray(pos, np.int64)]
+        R = self._rows_at(pos)
         real = R >= 0
         require_memory(8 * (self.n_rows + 1) + 16 * int(real.sum()), "the constraint matrix",
                        f"{self.n_rows} rows x {len(R)} candidates")
@@ -101,8 +117,24 @@ class IndexArithmetic:
 
     def uncovered_rows(self, pos: ArrayLike | None = None) -> np.ndarray:
         """Constraint rows that no candidate (of ``pos``, if given) covers."""
-        R = self.entry_rows if pos is None else self.entry_rows[np.asarray(pos, np.int64)]
-        return np.flatnonzero(np.bincount(R[R >= 0], minlength=self.n_rows) == 0)
+        if pos is None or "entry_rows" in self.__dict__:
+            R = self._rows_at(pos)
+            return np.flatnonzero(np.bincount(R[R >= 0], minlength=self.n_rows) == 0)
+        T = self.tuples[np.asarray(pos, np.int64)]    # per axis: no row numbers needed
+        return np.concatenate([
+            np.flatnonzero(np.bincount(T[:, s], minlength=n + 1)[1:] == 0) + self.row_offsets[s]
+            for s, n in enumerate(self.sizes)]).astype(np.int64)
+
+    def _rows_at(self, pos: ArrayLike | None) -> np.ndarray:
+        """:attr:`entry_rows` of the candidates ``pos`` (all when None), from the cache
+        when it is built, else of those candidates only: a window of a fifth of a
+        dense 3-AP's candidates need not pay for all of them."""
+        if pos is None:
+            return self.entry_rows
+        pos = np.asarray(pos, np.int64)
+        if "entry_rows" in self.__dict__:
+            return self.entry_rows[pos]
+        return self.rows_of(self.tuples[pos])
 
     def uncovered(self, limit: int | None = None) -> list[tuple[int, int]]:
         """Real indices ``(axis, index)`` that no candidate covers (1-based index),

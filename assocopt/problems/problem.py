@@ -273,7 +273,7 @@ class AssignmentProblem(IndexArithmetic):
             return "selection refers to a candidate that does not exist"
         if len(np.unique(sel)) != len(sel):
             return "a candidate is selected twice"
-        R = self.entry_rows[sel]
+        R = self._rows_at(sel)
         rows, count = np.unique(R[R >= 0], return_counts=True)
         twice = np.flatnonzero(count > 1)
         if len(twice):

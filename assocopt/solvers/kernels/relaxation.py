@@ -196,22 +196,90 @@ def reduced(G, c, yfull, rp, ptr, lst, axis_of):
 @njit(cache=True)
 def sort_lists(ptr, lst, rp, slack):
     """Each row's candidates with ``rp < slack`` (reduced-cost fixing: the others
-    cannot be in a solution better than the incumbent), sorted by ``rp`` (stable:
-    deterministic).  Returns the new ``(ptr, lst)``."""
+    cannot be in a solution better than the incumbent), sorted by ``rp`` (ties by
+    candidate: deterministic).  Returns the new ``(ptr, lst)``.
+
+    One stable sort of the kept candidates (:func:`stable_order`), then a counting
+    placement into the rows, not a sort per row: a third of the time on a
+    24,000-candidate 3-AP window."""
     E = ptr.shape[0] - 1
-    ptr2 = np.zeros(E + 1, np.int64)
-    out = np.empty(lst.shape[0], np.int64)
-    n = 0
+    K = rp.shape[0]
+    start = np.zeros(K + 1, np.int64)          # the rows of each kept candidate (CSR)
+    for p in range(lst.shape[0]):
+        k = lst[p]
+        if rp[k] < slack:
+            start[k + 1] += 1
+    for k in range(K):
+        start[k + 1] += start[k]
+    rows = np.empty(start[K], np.int64)
+    fill = start[:K].copy()
     for e in range(E):
-        start = n
         for p in range(ptr[e], ptr[e + 1]):
             k = lst[p]
             if rp[k] < slack:
-                out[n] = k
-                n += 1
-        if n - start > 1:
-            seg = out[start:n].copy()
-            order = np.argsort(rp[seg], kind="mergesort")
-            out[start:n] = seg[order]
-        ptr2[e + 1] = n
-    return ptr2, out[:n]
+                rows[fill[k]] = e
+                fill[k] += 1
+    order = stable_order(rp, np.flatnonzero(start[1:] > start[:K]))
+    ptr2 = np.zeros(E + 1, np.int64)
+    for q in range(rows.shape[0]):
+        ptr2[rows[q] + 1] += 1
+    for e in range(E):
+        ptr2[e + 1] += ptr2[e]
+    out = np.empty(rows.shape[0], np.int64)
+    at = ptr2[:E].copy()
+    for k in order:
+        for q in range(start[k], start[k + 1]):
+            e = rows[q]
+            out[at[e]] = k
+            at[e] += 1
+    return ptr2, out
+
+
+@njit(cache=True)
+def stable_order(v, keep):
+    """``keep`` (ascending positions) sorted by ``v[keep]``, ties in ``keep`` order.
+
+    A bucket sort (about two entries a bucket, spread over the range of the values)
+    then insertion sort inside each bucket, a comparison sort for a crowded one:
+    linear time on the reduced costs of a window, where a merge sort of 24,000 of
+    them took 2 ms."""
+    m = keep.shape[0]
+    if m < 64:
+        return keep[np.argsort(v[keep], kind="mergesort")]
+    lo, hi = INF, -INF
+    for k in keep:
+        lo = min(lo, v[k])
+        hi = max(hi, v[k])
+    if not hi > lo or not np.isfinite(hi - lo):
+        return keep[np.argsort(v[keep], kind="mergesort")] if not hi == lo else keep.copy()
+    B = m // 2
+    scale = B / (hi - lo)
+    bucket = np.empty(m, np.int64)
+    first = np.zeros(B + 1, np.int64)
+    for q in range(m):
+        b = min(int((v[keep[q]] - lo) * scale), B - 1)
+        bucket[q] = b
+        first[b + 1] += 1
+    for b in range(B):
+        first[b + 1] += first[b]
+    out = np.empty(m, np.int64)
+    at = first[:B].copy()
+    for q in range(m):
+        b = bucket[q]
+        out[at[b]] = keep[q]
+        at[b] += 1
+    for b in range(B):
+        i0, i1 = first[b], first[b + 1]
+        if i1 - i0 > 32:
+            seg = out[i0:i1].copy()
+            out[i0:i1] = seg[np.argsort(v[seg], kind="mergesort")]
+            continue
+        for i in range(i0 + 1, i1):
+            k = out[i]
+            x = v[k]
+            j = i
+            while j > i0 and v[out[j - 1]] > x:
+                out[j] = out[j - 1]
+                j -= 1
+            out[j] = k
+    return out

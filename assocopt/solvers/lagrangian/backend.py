@@ -21,7 +21,7 @@ from ..kernels import spent
 from ..twod.lap import LapInfeasibleError
 from .ascent import _State, _ascent
 from .compiled_ascent import _ascent_grid, applies
-from .fixing import fixing_bounds, make_probe
+from .fixing import fixing_bounds, fixing_order, make_probe
 from .local_search import _LocalSearch
 from .options import OPTIONS, OPTIONS_EXACT, check_engines, resolve_defaults
 from .reduction import dominated
@@ -150,11 +150,9 @@ class _LagrangianBase(Backend):
         gpos = pos[rel.pos]
         red_of = np.full(problem.n_candidates, np.inf)
         red_of[gpos] = red
-        order = _sort_below(lb, st.ub)
-        lb, gpos = lb[order], gpos[order]
-        lo = st.bound
-        if st.integer:
-            lb, lo = np.ceil(lb - 1e-6), float(math.ceil(lo - 1e-6))
+        lo = float(math.ceil(st.bound - 1e-6)) if st.integer else st.bound
+        lb, order = fixing_order(lb, lo, st.ub, st.integer)
+        gpos = gpos[order]
         times["fixing"] = time.perf_counter() - t0
         t0 = time.perf_counter()
         windows: list[dict[str, Any]] = []
@@ -345,17 +343,6 @@ class _LagrangianBase(Backend):
             return RawResult(status, message=message, info=info, solve_time=solve_time)
         return RawResult(status, selected=st.incumbent, bound=bound, message=message,
                          info=info, solve_time=solve_time)
-
-
-def _sort_below(lb: np.ndarray, ub: float) -> np.ndarray:
-    """The stable order of ``lb`` as far as windows look (the entries below ``ub``;
-    those at or above it, which no window below the incumbent holds, follow in any
-    order): sorting only those costs a fraction on Grundel n = 50."""
-    below = np.flatnonzero(lb < ub)
-    if len(below) == len(lb):
-        return np.argsort(lb, kind="stable")
-    rest = np.flatnonzero(~(lb < ub))
-    return np.concatenate([below[np.argsort(lb[below], kind="stable")], rest])
 
 
 @register

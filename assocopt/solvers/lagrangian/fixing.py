@@ -44,17 +44,19 @@ def make_probe(rel: _Relaxation, pos: np.ndarray, st: _State, problem: Assignmen
     incumbent, or a window of at most ``search_max`` candidates (8 times that with the
     ``compiled`` search) that a short search settles; else None."""
     gpos = pos[rel.pos]
+    local = np.full(len(st.costs), -1, np.int64)      # candidate -> entry of lb
+    local[gpos] = np.arange(len(gpos))
 
     def probe(u: np.ndarray) -> str | None:
+        if st.incumbent is None:          # nothing to prove (the kernels probe with one)
+            return None
         lb, red, base = fixing_bounds(rel, u)
-        if st.integer:
-            keep = np.ceil(lb - 1e-6) < st.ub
+        if st.integer:        # ceil(lb - 1e-6) < ub, ub a whole number
+            keep = lb <= st.ub - 1.0 + 1e-6
         else:
             keep = lb - st.tol() < st.ub
-        mine = np.zeros(len(st.costs), bool)
-        mine[st.incumbent] = True
-        keep &= ~mine[gpos]
-        n = int(keep.sum())
+        mine = local[st.incumbent]
+        n = int(np.count_nonzero(keep)) - int(np.count_nonzero(keep[mine[mine >= 0]]))
         if n == 0:
             st.proof = "reduced-cost fixing left only the incumbent"
             st.bound = max(st.bound, st.ub)
@@ -77,3 +79,41 @@ def make_probe(rel: _Relaxation, pos: np.ndarray, st: _State, problem: Assignmen
                 return "proven"
         return None
     return probe
+
+
+def fixing_order(lb: np.ndarray, lo: float, ub: float, integer: bool
+                 ) -> tuple[np.ndarray, np.ndarray]:
+    """The fixing bounds in the order the windows grow, ``(bounds, order)``: rounded
+    up to whole units for integer costs (:func:`_levels`), else sorted as far as the
+    incumbent ``ub`` (:func:`_sort_below`).  ``lo`` is the bound the windows start at."""
+    if integer:
+        return _levels(lb, lo, ub)
+    order = _sort_below(lb, ub)
+    return lb[order], order
+
+
+def _levels(lb: np.ndarray, lo: float, ub: float) -> tuple[np.ndarray, np.ndarray]:
+    """Integer costs: the fixing bounds rounded up to whole units and put in order,
+    ``(levels, order)``.  Windows are unions of whole levels, so the order within a
+    level does not matter, and levels below ``lo`` (in every window) or above the
+    incumbent (in none) are merged: a counting sort of small integers, about a sixth
+    of a full sort of 125,000 bounds on Grundel n = 50."""
+    top = ub - lo + 1.0
+    if not (math.isfinite(top) and top < np.iinfo(np.int16).max):
+        order = _sort_below(lb, ub)
+        return np.ceil(lb[order] - 1e-6), order
+    lev = np.ceil(lb - 1e-6) - lo
+    np.clip(lev, 0.0, top, out=lev)
+    order = np.argsort(lev.astype(np.int16), kind="stable")    # radix sort
+    return lev[order] + lo, order
+
+
+def _sort_below(lb: np.ndarray, ub: float) -> np.ndarray:
+    """The stable order of ``lb`` as far as windows look (the entries below ``ub``;
+    those at or above it, which no window below the incumbent holds, follow in any
+    order): sorting only those costs a fraction on Grundel n = 50."""
+    below = np.flatnonzero(lb < ub)
+    if len(below) == len(lb):
+        return np.argsort(lb, kind="stable")
+    rest = np.flatnonzero(~(lb < ub))
+    return np.concatenate([below[np.argsort(lb[below], kind="stable")], rest])

@@ -14,6 +14,8 @@ import math
 
 import numpy as np
 
+from ...problems.indexing import real_counts
+
 
 def dominated(sizes: tuple[int, ...], T: np.ndarray, c: np.ndarray,
               compiled: bool | None = None) -> np.ndarray:
@@ -35,8 +37,7 @@ def dominated(sizes: tuple[int, ...], T: np.ndarray, c: np.ndarray,
     [True, False, False]
     """
     K, N = T.shape
-    real = T > 0
-    nreal = real.sum(axis=1)
+    nreal = real_counts(T)
     multi = nreal >= 2
     if K == 0 or not multi.any() or nreal.min() == nreal.max():
         return np.zeros(K, bool)
@@ -45,6 +46,7 @@ def dominated(sizes: tuple[int, ...], T: np.ndarray, c: np.ndarray,
         compiled = module_installed("numba")
     if compiled:
         return _dominated_compiled(sizes, T, c, nreal)
+    real = T > 0
     single = np.flatnonzero(nreal == 1)
     S = [np.full(n + 1, np.inf) for n in sizes]
     s_axis = real[single].argmax(axis=1)

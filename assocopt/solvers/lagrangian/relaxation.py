@@ -14,6 +14,7 @@ from typing import Any
 import numpy as np
 
 from ...runtime.errors import InvalidProblemError
+from ...problems.indexing import real_counts
 from ...problems.problem import AssignmentProblem
 from ..base import module_installed
 from ..twod.lap import (Assignment2D, LapInfeasibleError, assign_with_misses, assignment_duals,
@@ -147,7 +148,7 @@ class _Relaxation:
         upad = np.zeros(self.u_len)
         if not self.K or not self.uidx:
             return upad
-        share = self.c / np.maximum((self.T > 0).sum(axis=1), 1)
+        share = self.c / np.maximum(real_counts(self.T), 1)
         best = np.full(self.u_len, np.inf)
         for ui in self.uidx:
             np.minimum.at(best, ui, share)
