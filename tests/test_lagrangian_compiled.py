@@ -168,3 +168,32 @@ def test_small_grids_take_numpy_by_default(monkeypatch):
         p = AssignmentProblem.dense(np.random.default_rng(n).random((n, n, n)))
         rel = R._Relaxation(p.sizes, p.tuples, p.costs, (0, 1), "auto")
         assert rel.compiled is compiled, n
+
+
+@settings(max_examples=60, deadline=None)
+@given(sd_problems(), st.sampled_from([0.0, 2.0, 1e9]), st.booleans())
+def test_window_search_stops_at_a_proven_floor(p, above, compiled):
+    """The window search with a lower bound proven elsewhere (``floor``): at the true
+    optimum it returns an optimal cover; at any floor the cover it returns is a real
+    one, at most the floor when it stopped early (so a wrong floor shows)."""
+    from assocopt.solvers.lagrangian.window import _compiled_search, _cover_search
+    ref = solve(p, "bruteforce")
+    if ref.status is not Status.OPTIMAL:
+        return
+    pos = np.arange(p.n_candidates)
+    red = np.zeros(p.n_candidates)                   # base 0: only the costs bound
+    base = min(0.0, float(p.costs.min())) * p.n_rows
+    floor = ref.objective + above
+    if compiled:
+        sel, complete = _compiled_search(p, pos, red, base, np.inf, p.integer_costs,
+                                         100_000, floor)
+    else:
+        sel, complete = _cover_search(p, pos, red, base, np.inf, 100_000, floor=floor)
+    assert complete and sel is not None
+    assert p.violations(sel) is None
+    z = p.objective_of(sel)
+    assert z >= ref.objective - 1e-9
+    if above == 0.0:
+        assert z == pytest.approx(ref.objective, abs=1e-9)
+    elif above == 1e9 and p.n_candidates > 1:
+        assert z <= floor                              # the first cover found ends it

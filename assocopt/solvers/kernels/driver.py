@@ -205,7 +205,7 @@ def solve(G, pa, pb, c, relaxed, a, b, off_a, off_b, na, nb, plain, axis_of, ptr
                                     improve_limit(ub, int_costs, tol) - base)
             out, ub, best_len, nn = dfs(G, c, rp, base, sptr, slst, axis_of, N,
                                         int_costs, tol, ub, best_sel, best_len,
-                                        probe_budget, stop)
+                                        probe_budget, stop, -INF)
             nodes += nn
             if out == COMPLETE:
                 return PROVEN, best_sel, best_len, ub, best_L, it, nodes
@@ -226,7 +226,7 @@ def solve(G, pa, pb, c, relaxed, a, b, off_a, off_b, na, nb, plain, axis_of, ptr
     base = reduced(G, c, ybest, rp, ptr, lst, axis_of)
     sptr, slst = sort_lists(ptr, lst, rp, improve_limit(ub, int_costs, tol) - base)
     out, ub, best_len, nn = dfs(G, c, rp, base, sptr, slst, axis_of, N, int_costs, tol,
-                                ub, best_sel, best_len, budget, stop)
+                                ub, best_sel, best_len, budget, stop, -INF)
     nodes += nn
     if out == COMPLETE:
         return PROVEN, best_sel, best_len, ub, best_L, it, nodes

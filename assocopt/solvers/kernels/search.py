@@ -56,7 +56,7 @@ def _select(G, rp, ptr, lst, axis_of, covered, slack, rem):
 
 @njit(cache=True, nogil=True)
 def dfs(G, c, rp, base, ptr, lst, axis_of, n_axes, int_costs, tol, ub, best_sel,
-        best_len, budget, stop):
+        best_len, budget, stop, floor):
     """Depth-first exact-cover search for a solution cheaper than ``ub``.
 
     Stops as if the node budget were spent when ``stop[0]`` is set non-zero (checked
@@ -67,7 +67,10 @@ def dfs(G, c, rp, base, ptr, lst, axis_of, n_axes, int_costs, tol, ub, best_sel,
     Candidates are tried cheapest reduced cost first; a node is cut when
     ``base + acc + bound`` reaches the improvement limit.  Returns ``(outcome, ub,
     best_len, nodes)``; ``best_sel[:best_len]`` holds the incumbent.  ``COMPLETE``
-    means no solution cheaper than the returned ``ub`` exists.
+    means no solution cheaper than the returned ``ub`` exists.  ``floor``: a lower
+    bound proven elsewhere (-inf if none); a solution that reaches it ends the search
+    at once (the last window of ``lagrangian-exact`` otherwise proved again what the
+    smaller windows before it had: Balas-Saltzman n = 22-26, 10-27 ms a window).
     """
     E = ptr.shape[0] - 1
     covered = np.zeros(E, np.bool_)
@@ -130,6 +133,8 @@ def dfs(G, c, rp, base, ptr, lst, axis_of, n_axes, int_costs, tol, ub, best_sel,
                 best_sel[:d + 1] = stack_k[:d + 1]
                 best_len = d + 1
                 limit = improve_limit(ub, int_costs, tol)
+                if limit <= floor:                  # nothing better can exist
+                    return COMPLETE, ub, best_len, nodes
             continue
         if nodes >= budget or stop[0] != 0:
             return BUDGET, ub, best_len, nodes

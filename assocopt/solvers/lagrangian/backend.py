@@ -260,10 +260,10 @@ class _LagrangianBase(Backend):
         split = compiled and len(win) >= _SPLIT_MIN and bool((problem.tuples[win] == 0).any())
         args = (problem, win, red_of[win], base, cap, st, compiled, _SEARCH_MAX, _SEARCH_NODES)
         found = None if searched and compiled else \
-            _search(*args, _OPEN_NODES if skip or split else _COMPILED_NODES)
+            _search(*args, _OPEN_NODES if skip or split else _COMPILED_NODES, floor=lo)
         if found is None and split and not searched:  # components, or (connected) search
             found = _by_components(problem, win, st, options, deadline) or \
-                (None if skip else _search(*args, _COMPILED_NODES))
+                (None if skip else _search(*args, _COMPILED_NODES, floor=lo))
         if found is not None:
             return found
         if skip:                        # a larger window decides (see _Skipper)

@@ -67,10 +67,10 @@ def make_probe(rel: _Relaxation, pos: np.ndarray, st: _State, problem: Assignmen
             red_of[gpos] = red
             if compiled:
                 sel, complete = _compiled_search(problem, win, red_of[win], base,
-                                                 st.ub, st.integer, 3_000)
+                                                 st.ub, st.integer, 3_000, st.bound)
             else:
                 sel, complete = _cover_search(problem, win, red_of[win], base, st.ub,
-                                              node_limit=3_000)
+                                              node_limit=3_000, floor=st.bound)
             if complete:
                 if sel is not None:
                     st.offer(sel)

@@ -79,15 +79,17 @@ class _Skipper:
 
 def _search(problem: AssignmentProblem, pos: np.ndarray, red: np.ndarray, base: float,
             cap: float, st: _State, compiled: bool, search_max: int, search_nodes: int,
-            nodes: int) -> tuple[Outcome, float | None, str] | None:
+            nodes: int, floor: float = -math.inf) -> tuple[Outcome, float | None, str] | None:
     """The window ``pos`` by the compiled search (``nodes``) or, without numba and up
     to ``search_max`` candidates, the Python one (``search_nodes``); None when it ran
     out of nodes (or did not run)."""
     if compiled:
-        sel, complete = _compiled_search(problem, pos, red, base, cap, st.integer, nodes)
+        sel, complete = _compiled_search(problem, pos, red, base, cap, st.integer, nodes,
+                                         floor)
         how = "compiled search"
     elif len(pos) <= search_max:
-        sel, complete = _cover_search(problem, pos, red, base, cap, node_limit=search_nodes)
+        sel, complete = _cover_search(problem, pos, red, base, cap, node_limit=search_nodes,
+                                      floor=floor)
         how = "search"
     else:
         return None

@@ -91,8 +91,8 @@ def _has_numba() -> bool:
 
 
 def _compiled_search(problem: AssignmentProblem, pos: np.ndarray, red: np.ndarray,
-                     base: float, cap: float, integer: bool, node_limit: int
-                     ) -> tuple[np.ndarray | None, bool]:
+                     base: float, cap: float, integer: bool, node_limit: int,
+                     floor: float = -math.inf) -> tuple[np.ndarray | None, bool]:
     """:func:`_cover_search` compiled (the ``bnb`` kernels' depth-first search):
     same contract, about a hundred times faster per node."""
     from ..bnb import kernels as kern
@@ -114,7 +114,7 @@ def _compiled_search(problem: AssignmentProblem, pos: np.ndarray, red: np.ndarra
 
     stop = new_stop()
     args = (G, c, rp, base, sptr, slst, axis_of, problem.ndim, integer, OPT_TOL, cap,
-            best, -1, node_limit, stop)
+            best, -1, node_limit, stop, float(floor))
     kern.pick(kern.name("dfs"), *args, work=work)     # compile now (timed apart)
     (out, _, n, _), _ = kern.run_tiered(kern.name("dfs"), args, stop, work=work,
                                         inline=node_limit <= 20_000)
@@ -136,9 +136,10 @@ def _coverage(problem: AssignmentProblem, pos: np.ndarray) -> sp.csr_matrix:
 
 
 def _cover_search(problem: AssignmentProblem, pos: np.ndarray, red: np.ndarray,
-                  base: float, cap: float, node_limit: int = 20_000
-                  ) -> tuple[np.ndarray | None, bool]:
-    """Cheapest exact cover by the candidates ``pos`` costing less than ``cap``.
+                  base: float, cap: float, node_limit: int = 20_000,
+                  floor: float = -math.inf) -> tuple[np.ndarray | None, bool]:
+    """Cheapest exact cover by the candidates ``pos`` costing less than ``cap``
+    (``floor``: a lower bound proven elsewhere; a cover reaching it ends the search).
 
     Depth-first branch and bound for small windows.  Every solution ``S`` costs at
     least ``base + sum_{k in S} red[k]`` (``red >= 0``, from the Lagrangian duals, see
@@ -150,7 +151,7 @@ def _cover_search(problem: AssignmentProblem, pos: np.ndarray, red: np.ndarray,
     ``complete`` is False when the node limit stopped the search (nothing proven).
     """
     K = len(pos)
-    rows_of = problem.entry_rows[pos].tolist()
+    rows_of = problem.rows_of(problem.tuples[pos]).tolist()
     cost = problem.costs[pos].tolist()
     rd = np.asarray(red, np.float64).tolist()
     cols = [[r for r in rk if r >= 0] for rk in rows_of]
@@ -172,11 +173,16 @@ def _cover_search(problem: AssignmentProblem, pos: np.ndarray, red: np.ndarray,
     best = [cap - tol, None]
     nodes = [0]
     chosen: list[int] = []
+    reach = floor + OPT_TOL * max(1.0, abs(floor)) if math.isfinite(floor) else -math.inf
+    done = [False]
 
     def search(covered: int, acc: float, racc: float, rest: float) -> bool:
         if covered == full:
             if acc < best[0]:
                 best[0], best[1] = acc, list(chosen)
+                if acc <= reach:                 # optimal: stop the whole search
+                    done[0] = True
+                    return False
             return True
         nodes[0] += 1
         if nodes[0] > node_limit:
@@ -206,7 +212,7 @@ def _cover_search(problem: AssignmentProblem, pos: np.ndarray, red: np.ndarray,
                 return False
         return True
 
-    complete = search(0, 0.0, 0.0, sum(share))
+    complete = search(0, 0.0, 0.0, sum(share)) or done[0]
     sel = None if best[1] is None else np.sort(pos[np.array(best[1], np.int64)])
     return sel, complete
 
