@@ -65,23 +65,38 @@ def _same(chosen, last, si):
     return False
 
 
+#: Entries of each sorted pair :func:`grid_eval_sorted` reads before its early stop
+#: (Grundel n = 50: 3.8 entries a pair are needed; 8 read unconditionally took 61 us
+#: an evaluation where the test at every entry took 78 us).
+_HEAD = 8
+
+
 @njit(cache=True)
 def grid_eval_sorted(Cs, Is, w, n, v0):
     """:func:`.grid.grid_eval` (same answers, ties to the least relaxed index) on the
     sorted rows (``Cs``: each pair's costs in increasing order, ``Is``: their relaxed
     indices): a pair's scan stops at the first cost that,
     less the largest multiplier, exceeds the pair's best so far (Grundel n = 50: a
-    fifth of the entries)."""
+    fifth of the entries).  The first :data:`_HEAD` entries are taken without the
+    test: the minimum is almost always among them, and the loop without a branch to
+    mispredict runs a fifth faster."""
     G, m = Cs.shape
     am = np.empty(G, np.int64)
     gmin = np.empty(G)
     wmax = -np.inf
     for j in range(m):
         wmax = max(wmax, w[j])
+    head = min(_HEAD, m)
     for g in range(G):
         best = np.inf
         k = m
-        for t in range(m):
+        for t in range(head):
+            j = Is[g, t]
+            x = Cs[g, t] - w[j]
+            if x < best or (x == best and j < k):
+                best = x
+                k = j
+        for t in range(head, m):
             c = Cs[g, t]
             if c - wmax > best:
                 break
