@@ -72,7 +72,9 @@ class _LagrangianBase(Backend):
         t0 = time.perf_counter()
         pos = np.arange(problem.n_candidates)
         if p["reduce"]:
-            pos = pos[~dominated(problem.sizes, problem.tuples, c)]
+            drop = dominated(problem.sizes, problem.tuples, c)
+            if drop.any():
+                pos = pos[~drop]
             ncand["after_dominance"] = len(pos)
         gated = False
         if p["gate"] is not None:
@@ -86,7 +88,9 @@ class _LagrangianBase(Backend):
         # ---- ascent on the (reduced) candidate set
         t0 = time.perf_counter()
         try:
-            rel = _Relaxation(problem.sizes, problem.tuples[pos], c[pos], keep, p["lap"])
+            whole = len(pos) == problem.n_candidates     # no copies of a dense grid
+            rel = _Relaxation(problem.sizes, problem.tuples if whole else problem.tuples[pos],
+                              c if whole else c[pos], keep, p["lap"])
             info["lap_structure"] = "uniform" if rel.uniform else "grouped"
             compiled = _COMPILED_ASCENT and applies(rel)
             info["parameters"].update(resolve_defaults(p, compiled))
