@@ -209,6 +209,17 @@ def _grid_rules() -> str:
 
 
 _GRID_RULES = _grid_rules()
+
+
+def _nodes() -> dict[str, str]:
+    """The window search's node budgets, in words (from the solver's own constants)."""
+    from assocopt.solvers.lagrangian.policy import _OPEN_NODES, _SKIP_NODES
+    from assocopt.solvers.lagrangian.window import _COMPILED_NODES
+    return {"full": f"{_COMPILED_NODES:,}", "split": f"{_OPEN_NODES:,}",
+            "skip": f"{_SKIP_NODES:,}"}
+
+
+_NODES = _nodes()
 _COMPARED = [
     "## What is compared", "",
     "- `lagrangian`: Lagrangian relaxation of N-2 axes to a 2-D assignment "
@@ -219,11 +230,13 @@ _COMPARED = [
     "duals; the candidates whose bound lies below a threshold T form a *window* "
     "that holds every solution cheaper than T; windows grow until T reaches the "
     "incumbent and are solved by the compiled exact-cover search (numba, up to "
-    "100,000 nodes), then CP-SAT (integer costs, <= 1,500 candidates, 1 s budget) "
-    "or HiGHS (stopped at the proven bound).  A window of a problem with dummies "
-    "that splits into connected components is solved component by component "
-    "(`bnb` on each) when a first search of 10,000 nodes does not settle it; with "
-    "integer costs the search may give up on the first window after 10,000 nodes "
+    + _NODES["full"] + " nodes; it stops at the first cover that reaches the bound "
+    "the smaller windows proved), then CP-SAT (integer costs, <= 1,500 candidates, "
+    "1 s budget) or HiGHS (stopped at the proven bound).  A window of a problem "
+    "with dummies that splits into connected components is solved component by "
+    "component (`bnb` on each) when a first search of " + _NODES["split"] + " nodes "
+    "does not settle it; with integer costs the search may give up on the first "
+    "window after " + _NODES["skip"] + " nodes "
     "when the next one holds at least twice its candidates (the larger window "
     "decides; if it gives up too, the first gets the full treatment, and a first "
     "window that comes back goes to CP-SAT or HiGHS directly).  On dense square "

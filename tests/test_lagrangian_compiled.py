@@ -60,7 +60,7 @@ def _leave_windows(mp: pytest.MonkeyPatch, nodes: int, growth: float) -> None:
     """Give-up budget ``nodes``, successor growth ``growth``, no search in the ascent's
     fixing probes (else they settle small problems before any window)."""
     from assocopt.solvers.lagrangian import backend as lb, policy as lw
-    mp.setattr(lb, "_OPEN_NODES", nodes)
+    mp.setattr(lb, "_SKIP_NODES", nodes)
     mp.setattr(lw, "_SKIP_GROWTH", growth)
     mp.setattr(lb, "_PROBE_SEARCH_MAX", 0)
 

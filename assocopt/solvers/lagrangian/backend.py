@@ -26,7 +26,7 @@ from .local_search import _LocalSearch
 from .options import OPTIONS, OPTIONS_EXACT, check_engines, resolve_defaults
 from .reduction import dominated
 from .relaxation import _Relaxation
-from .policy import _OPEN_NODES, _SPLIT_MIN, _Skipper, _by_components, _search
+from .policy import _OPEN_NODES, _SKIP_NODES, _SPLIT_MIN, _Skipper, _by_components, _search
 from .window import (_COMPILED_NODES, _CPSAT_BUDGET, _CPSAT_MAX, _PROBE_SEARCH_MAX,
                      _SEARCH_MAX, _SEARCH_NODES, _cpsat,
                      Outcome, _grow, _has_numba, _has_ortools, _ilp, _uncovered)
@@ -264,7 +264,8 @@ class _LagrangianBase(Backend):
         split = compiled and len(win) >= _SPLIT_MIN and bool((problem.tuples[win] == 0).any())
         args = (problem, win, red_of[win], base, cap, st, compiled, _SEARCH_MAX, _SEARCH_NODES)
         found = None if searched and compiled else \
-            _search(*args, _OPEN_NODES if skip or split else _COMPILED_NODES, floor=lo)
+            _search(*args, _OPEN_NODES if split else _SKIP_NODES if skip else _COMPILED_NODES,
+                    floor=lo)
         if found is None and split and not searched:  # components, or (connected) search
             found = _by_components(problem, win, st, options, deadline) or \
                 (None if skip else _search(*args, _COMPILED_NODES, floor=lo))

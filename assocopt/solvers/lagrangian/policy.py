@@ -24,6 +24,14 @@ from .window import Outcome, _compiled_search, _cover_search
 #: larger one can decide) and on a window that may split: it gives up there in a few
 #: milliseconds instead of tenths of a second.
 _OPEN_NODES = 10_000
+#: ... and this many on a window it may give up on for a larger one (integer costs,
+#: :class:`_Skipper`): 10 000 nodes took 11-13 ms on the three Grundel n = 50 first
+#: windows (666-837 candidates) that hold no solution below the threshold, while
+#: the next window, ten times larger, settled in 1-3 ms.  Over the 120 public 3-AP
+#: instances 2 000 and 1 000 took the same time; 500 was too few on Grundel
+#: ap3.50.10 (its second window gave up too, and the first went to the engines:
+#: 0.24 s where it takes 0.03).
+_SKIP_NODES = 2_000
 #: The first window is left so only when the next (one cost unit up) holds at least
 #: this many times its candidates (Grundel n = 40-50: 2.3-15 times; Balas-Saltzman, whose
 #: windows do not get easier as they grow: about 1.3).
@@ -39,7 +47,7 @@ _NESTED = contextvars.ContextVar("assocopt_window_nested", default=False)
 
 
 class _Skipper:
-    """Which windows the compiled search may give up on (after :data:`_OPEN_NODES`
+    """Which windows the compiled search may give up on (after :data:`_SKIP_NODES`
     nodes) for a larger window to decide: the first one, when the next is much
     larger, and then the next; if that one gives up too, the first gets the full
     treatment (search, CP-SAT, HiGHS) after all (measured on Grundel n = 50: the
