@@ -13,16 +13,18 @@ from .outcomes import BUDGET, COMPLETE  # noqa: E402,F401  (dfs() outcomes)
 
 
 @njit(cache=True)
-def _free(G, k, covered):
-    for s in range(G.shape[1]):
+def _mark(G, ptr, lst, blocked, k, n_axes, delta):
+    """Add ``delta`` to the blocked count of every candidate sharing a row with ``k``
+    (``k`` chosen: +1; undone: -1), so that "is it free" is one load."""
+    for s in range(n_axes):
         e = G[k, s]
-        if e >= 0 and covered[e]:
-            return False
-    return True
+        if e >= 0:
+            for p in range(ptr[e], ptr[e + 1]):
+                blocked[lst[p]] += delta
 
 
 @njit(cache=True)
-def _select(G, rp, ptr, lst, axis_of, covered, slack, rem):
+def _select(blocked, rp, ptr, lst, axis_of, covered, slack, rem):
     """Branching row: the uncovered row with the fewest live candidates (Knuth's
     rule).  ``slack`` = limit - base - acc.  Returns ``(row, bound)``; row -1: some
     row has no live candidate (dead node).  ``bound`` = max over axes of the sum of
@@ -39,7 +41,7 @@ def _select(G, rp, ptr, lst, axis_of, covered, slack, rem):
             k = lst[p]
             if rp[k] >= slack:
                 break
-            if _free(G, k, covered):
+            if blocked[k] == 0:
                 if cnt == 0:
                     first = rp[k]
                 cnt += 1
@@ -74,6 +76,7 @@ def dfs(G, c, rp, base, ptr, lst, axis_of, n_axes, int_costs, tol, ub, best_sel,
     """
     E = ptr.shape[0] - 1
     covered = np.zeros(E, np.bool_)
+    blocked = np.zeros(rp.shape[0], np.int32)    # chosen candidates sharing a row
     rem = np.zeros(n_axes)
     stack_e = np.empty(E + 1, np.int64)
     stack_p = np.empty(E + 1, np.int64)
@@ -82,7 +85,7 @@ def dfs(G, c, rp, base, ptr, lst, axis_of, n_axes, int_costs, tol, ub, best_sel,
     nodes = 0
     ncov = 0
     acc = 0.0
-    e0, bnd = _select(G, rp, ptr, lst, axis_of, covered, limit - base, rem)
+    e0, bnd = _select(blocked, rp, ptr, lst, axis_of, covered, limit - base, rem)
     if e0 < 0 or base + bnd >= limit:
         return COMPLETE, ub, best_len, nodes
     d = 0
@@ -97,6 +100,7 @@ def dfs(G, c, rp, base, ptr, lst, axis_of, n_axes, int_costs, tol, ub, best_sel,
                 if e >= 0:
                     covered[e] = False
                     ncov -= 1
+            _mark(G, ptr, lst, blocked, k, n_axes, -1)
             acc -= rp[k]
             stack_k[d] = -1
         e = stack_e[d]
@@ -109,7 +113,7 @@ def dfs(G, c, rp, base, ptr, lst, axis_of, n_axes, int_costs, tol, ub, best_sel,
             if rp[k] >= slack:
                 p = ptr[e + 1]
                 break
-            if _free(G, k, covered):
+            if blocked[k] == 0:
                 found = k
                 break
         stack_p[d] = p
@@ -121,6 +125,7 @@ def dfs(G, c, rp, base, ptr, lst, axis_of, n_axes, int_costs, tol, ub, best_sel,
             if e >= 0:
                 covered[e] = True
                 ncov += 1
+        _mark(G, ptr, lst, blocked, found, n_axes, 1)
         acc += rp[found]
         stack_k[d] = found
         nodes += 1
@@ -138,7 +143,7 @@ def dfs(G, c, rp, base, ptr, lst, axis_of, n_axes, int_costs, tol, ub, best_sel,
             continue
         if nodes >= budget or stop[0] != 0:
             return BUDGET, ub, best_len, nodes
-        e2, bnd = _select(G, rp, ptr, lst, axis_of, covered, limit - base - acc, rem)
+        e2, bnd = _select(blocked, rp, ptr, lst, axis_of, covered, limit - base - acc, rem)
         if e2 < 0 or base + acc + bnd >= limit:
             continue
         d += 1
