@@ -46,6 +46,10 @@ def make_probe(rel: _Relaxation, pos: np.ndarray, st: _State, problem: Assignmen
     gpos = pos[rel.pos]
     local = np.full(len(st.costs), -1, np.int64)      # candidate -> entry of lb
     local[gpos] = np.arange(len(gpos))
+    # the last window the short search gave up on, and the incumbent then: a window
+    # no smaller, below the same incumbent, is not searched again (Balas-Saltzman
+    # n = 16: four searches of 3.4 ms on windows of 613, 613, 613 and 581 candidates)
+    failed = {"n": math.inf, "ub": math.nan}
 
     def probe(u: np.ndarray) -> str | None:
         if st.incumbent is None:          # nothing to prove (the kernels probe with one)
@@ -61,7 +65,8 @@ def make_probe(rel: _Relaxation, pos: np.ndarray, st: _State, problem: Assignmen
             st.proof = "reduced-cost fixing left only the incumbent"
             st.bound = max(st.bound, st.ub)
             return "proven"
-        if n + len(st.incumbent) <= (8 if compiled else 1) * search_max:
+        if n + len(st.incumbent) <= (8 if compiled else 1) * search_max and \
+                not (n >= failed["n"] and st.ub == failed["ub"]):
             win = np.union1d(gpos[keep], st.incumbent)
             red_of = np.full(len(st.costs), np.inf)
             red_of[gpos] = red
@@ -77,6 +82,7 @@ def make_probe(rel: _Relaxation, pos: np.ndarray, st: _State, problem: Assignmen
                 st.proof = "search over the candidates left by reduced-cost fixing"
                 st.bound = max(st.bound, st.ub)
                 return "proven"
+            failed.update(n=n, ub=st.ub)
         return None
     return probe
 
