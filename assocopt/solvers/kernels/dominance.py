@@ -5,6 +5,8 @@ numpy passes (one per split of the axes) with a sorted-key lookup each.  Tuples 
 keyed by their mixed-radix number and looked up in an open-addressing hash table
 (Fibonacci hashing), so a split costs two probes.  Measured on the largest component
 of a gated N = 5 tracking scan (12,326 candidates): 63 ms in numpy, a few ms here.
+A candidate's splits are those of its real axes only, each once, and the first split
+that dominates it ends its loop: a gated N = 6 scan (15,421 candidates) 5.4 -> 2.7 ms.
 """
 
 from __future__ import annotations
@@ -89,8 +91,19 @@ def dominated_kernel(T, c, off, radix, single_cost, use_keys):
         if m < 2:
             continue
         best = tot
-        if use_keys:
-            for mask in range(1, (1 << N) - 1, 2):      # splits: A holds axis 0
+        if use_keys and best > c[k]:
+            # the splits of the real axes into two non-empty parts, each once: A
+            # holds the lowest real axis and a proper subset of the others
+            real = 0
+            for s in range(N):
+                if T[k, s] > 0:
+                    real |= 1 << s
+            low = real & -real
+            rest = real ^ low
+            sub = rest
+            while sub != 0:
+                sub = (sub - 1) & rest
+                a_mask = low | sub
                 ka = 0
                 kb = 0
                 ra = 0
@@ -98,8 +111,8 @@ def dominated_kernel(T, c, off, radix, single_cost, use_keys):
                 sa = 0.0
                 sb = 0.0
                 for s in range(N):
-                    if T[k, s] > 0:
-                        if (mask >> s) & 1:
+                    if (real >> s) & 1:
+                        if (a_mask >> s) & 1:
                             ka += T[k, s] * radix[s]
                             ra += 1
                             sa += part[s]
@@ -107,12 +120,12 @@ def dominated_kernel(T, c, off, radix, single_cost, use_keys):
                             kb += T[k, s] * radix[s]
                             rb += 1
                             sb += part[s]
-                if ra == 0 or rb == 0:
-                    continue
                 # one real index: its own candidate is the single-index one
                 va = sa if ra == 1 else min(_lookup(skey, scost, shift, ka), sa)
                 vb = sb if rb == 1 else min(_lookup(skey, scost, shift, kb), sb)
                 if va + vb < best:
                     best = va + vb
+                    if best <= c[k]:              # dominated: no need to look further
+                        break
         out[k] = c[k] >= best
     return out
