@@ -79,6 +79,18 @@ def test_uncovered_names_axis_and_index():
     assert p.uncovered() == [(1, 2)]
 
 
+def test_n_uncovered_of_full_grids_and_of_grids_with_a_hole():
+    """A full grid of real tuples covers everything; one with as many tuples but a
+    dummy among them, or with a forbidden entry, is counted."""
+    assert AssignmentProblem.dense(np.ones((3, 3, 3))).n_uncovered == 0
+    C = np.ones((2, 2, 2))
+    C[1, :, :] = np.inf                         # real index 2 of axis 0: no candidate
+    assert AssignmentProblem.dense(C).n_uncovered == 1
+    T = [[1, 1], [1, 0], [0, 1], [0, 2]]         # 4 tuples = 2 x 2, index 2 of axis 0 missing
+    p = AssignmentProblem.sparse((2, 2), T, [1.0, 1.0, 1.0, 1.0])
+    assert p.n_uncovered == 1 and p.uncovered() == [(0, 2)]
+
+
 @pytest.mark.parametrize("cached", [False, True])
 def test_window_rows_agree_with_the_cached_rows(cached):
     """uncovered_rows, coverage_matrix and violations of a subset of the candidates

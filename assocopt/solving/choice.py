@@ -58,7 +58,7 @@ def choose_solver(problem: AssignmentProblem, relax: str | None = None) -> str:
         return "highs"
     if problem.ndim == 2:
         return "scipy-lsa"
-    gated = bool((problem.tuples == 0).any())
+    gated = problem.n_candidates > 0 and int(problem.tuples.min()) == 0   # a dummy index
     cap = bnb_cap(gated) if gated or not _square_grid(problem) else BNB_MAX_GRID
     if problem.n_candidates <= cap and _bnb_usable(problem):
         return "bnb"
