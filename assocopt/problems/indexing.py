@@ -118,10 +118,8 @@ class IndexArithmetic:
 
     def uncovered_rows(self, pos: ArrayLike | None = None) -> np.ndarray:
         """Constraint rows that no candidate (of ``pos``, if given) covers."""
-        if pos is None or "entry_rows" in self.__dict__:
-            R = self._rows_at(pos)
-            return np.flatnonzero(np.bincount(R[R >= 0], minlength=self.n_rows) == 0)
-        T = self.tuples[np.asarray(pos, np.int64)]    # per axis: no row numbers needed
+        # per axis: no row numbers needed (nor the cache of all candidates' rows)
+        T = self.tuples if pos is None else self.tuples[np.asarray(pos, np.int64)]
         return np.concatenate([
             np.flatnonzero(np.bincount(T[:, s], minlength=n + 1)[1:] == 0) + self.row_offsets[s]
             for s, n in enumerate(self.sizes)]).astype(np.int64)
