@@ -131,6 +131,44 @@ def test_components_counted(p):
             assert (used == np.arange(1, sizes[c, s] + 1)).all()
 
 
+@settings(max_examples=30, deadline=None)
+@given(side_by_side())
+def test_split_kernel_equals_numpy_route(p):
+    """The union-find kernel (compiled, and as its plain twin) gives the numpy route's
+    split, labels and candidate order included."""
+    pytest.importorskip("numba")
+    from assocopt.problems.components import split_rows
+    from assocopt.solvers.kernels import tiers
+    from assocopt.solvers.kernels.components import split_rows as compiled
+    R = np.ascontiguousarray(p.entry_rows, np.int64)
+    want = split_rows(R, p.n_rows)
+    for fn in (compiled, tiers.plain("components.split_rows")):
+        got = fn(R, p.n_rows)
+        assert got[0] == want[0]
+        for a, b in zip(got[1:], want[1:]):
+            assert np.array_equal(a, b)
+
+
+def test_split_routes_by_the_tier_rule(monkeypatch):
+    """``split(p, routed)``: the numpy route (charged to the kernel's budget) while
+    interpreted, the kernel once compiled; the same split either way."""
+    pytest.importorskip("numba")
+    from assocopt.solvers.kernels import routed, tiers
+    T = np.array([[1, 1, 0], [2, 0, 1], [0, 2, 1], [3, 0, 0]])
+    p = AssignmentProblem.sparse((3, 2, 1), T, np.arange(4.0))
+    monkeypatch.setattr(tiers, "_SPENT", {})
+    tiers.set_mode("interpreted")
+    try:
+        a = split(p, routed)
+        assert tiers.interpreted_seconds().get("components.split_rows", 0) > 0
+        tiers.set_mode("compiled")
+        b = split(p, routed)
+    finally:
+        tiers.set_mode(None)
+    assert a.n == b.n == 3
+    assert np.array_equal(a.order, b.order) and np.array_equal(a.of_row, b.of_row)
+
+
 def test_singletons_only_settled_without_solver():
     T = np.array([[1, 0, 0], [0, 1, 0], [0, 0, 1], [2, 0, 0]])
     p = AssignmentProblem.sparse((2, 1, 1), T, [1.0, -2.0, 0.5, 3.0])

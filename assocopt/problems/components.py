@@ -6,18 +6,21 @@ split much further than the problem they come from).
 
 Components are found in bulk: a graph on the real indices (constraint rows) with an
 edge from each candidate's first real index to each of its other ones, and
-:func:`scipy.sparse.csgraph.connected_components` on it.
+:func:`scipy.sparse.csgraph.connected_components` on it; or, where the solvers run
+it compiled, one union-find pass (:mod:`assocopt.solvers.kernels.components`, the same
+labels: components in the order of their smallest row).
 """
 
 from __future__ import annotations
 
 from dataclasses import dataclass
+from typing import Callable
 
 import numpy as np
 
 from .problem import AssignmentProblem
 
-__all__ = ["Split", "split", "local_tuples", "subproblem"]
+__all__ = ["Split", "split", "split_rows", "local_tuples", "subproblem"]
 
 
 @dataclass(frozen=True)
@@ -43,13 +46,26 @@ class Split:
         return np.diff(self.ptr)
 
 
-def split(problem: AssignmentProblem) -> Split:
-    """The connected components of ``problem`` (every real index covered)."""
+def split(problem: AssignmentProblem, run: Callable | None = None) -> Split:
+    """The connected components of ``problem`` (every real index covered).
+
+    ``run``: :func:`assocopt.solvers.kernels.routed` (the solvers pass it), which runs
+    the compiled kernel :func:`assocopt.solvers.kernels.components.split_rows` where
+    that costs less, else the numpy route below (same answer)."""
+    R = problem.entry_rows
+    if run is None:
+        return Split(*split_rows(R, problem.n_rows))
+    return Split(*run("components.split_rows", split_rows,
+                      np.ascontiguousarray(R, np.int64), problem.n_rows, work=len(R)))
+
+
+def split_rows(R: np.ndarray, E: int) -> tuple:
+    """``(n, of_row, of_cand, order, ptr, trivial)`` of entry rows ``R`` (K, N; -1 a
+    dummy) over ``E`` rows: numpy and scipy's ``connected_components``."""
     from scipy.sparse import csr_matrix
     from scipy.sparse.csgraph import connected_components
 
-    R = problem.entry_rows
-    K, E = len(R), problem.n_rows
+    K = len(R)
     real = R >= 0
     first = R[np.arange(K), np.argmax(real, axis=1)]
     src = np.broadcast_to(first[:, None], R.shape)[real]
@@ -66,7 +82,7 @@ def split(problem: AssignmentProblem) -> Split:
     np.cumsum(np.bincount(of_cand, minlength=n), out=ptr[1:])
     cover = np.bincount(R[real], minlength=E)
     trivial = np.bincount(of_row[cover > 1], minlength=n) == 0
-    return Split(n, of_row, of_cand, order, ptr, trivial)
+    return n, of_row, of_cand, order, ptr, trivial
 
 
 def local_tuples(problem: AssignmentProblem, part_of_row: np.ndarray, n_parts: int

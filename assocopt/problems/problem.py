@@ -204,7 +204,8 @@ class AssignmentProblem(IndexArithmetic):
                 f"costs must have shape ({len(T)},) to match tuples of shape "
                 f"({len(T)}, {N}), got shape {c.shape}")
         keep = np.isfinite(c)
-        T, c = T[keep], c[keep]
+        if not keep.all():
+            T, c = T[keep], c[keep]
         return cls._build(sizes_t, T, c, np.zeros(len(c), bool), kind="sparse",
                           name=name, optimum=optimum, maximize=maximize)
 

@@ -32,6 +32,7 @@ from typing import Any
 import numpy as np
 
 from ..problems.components import Split, local_tuples, split, subproblem as _subproblem
+from ..solvers.kernels import routed
 from ..problems.problem import AssignmentProblem
 from ..model.solution import Status
 from ..solvers.base import RawResult, SolveOptions, get_backend
@@ -122,7 +123,7 @@ def solve_decomposed(problem: AssignmentProblem, requested: str, name: str,
     if decompose is None and (problem.n_candidates < MIN_CANDIDATES or _full_grid(problem)):
         return None
     t0 = time.perf_counter()
-    sp = split(problem)
+    sp = split(problem, routed)
     if sp.n == 1 and not sp.trivial[0]:        # one component: the whole problem
         if requested == "auto":
             opts = _auto_options(problem, name, opts)

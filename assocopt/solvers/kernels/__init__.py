@@ -37,7 +37,7 @@ import logging
 import time
 from typing import Any, Iterator
 
-__all__ = ["ensure", "pick", "spent", "announced", "defer_interrupt",
+__all__ = ["ensure", "pick", "routed", "spent", "announced", "defer_interrupt",
            "uninterrupted"]
 
 _LOG = logging.getLogger("assocopt")
@@ -149,6 +149,27 @@ def pick(kernel: Any, *args: Any, work: float) -> Any:
     if hasattr(kernel, "py_func"):               # (NUMBA_DISABLE_JIT: a plain function)
         ensure(kernel, *args)
     return kernel
+
+
+def routed(kernel: str, fallback: Any, *args: Any, work: float) -> Any:
+    """``kernel(*args)`` compiled where :mod:`.tiers` chooses the compiled route, else
+    ``fallback(*args)``: for a kernel whose caller has a numpy route quicker than the
+    kernel's plain twin.  The fallback's time is charged to the kernel's interpreted
+    budget, so a process that keeps calling compiles it in the end (the ski rental of
+    :mod:`.tiers`)."""
+    from . import tiers
+
+    name = tiers.key(kernel)
+    if tiers.interpret(name, work, lambda: _cached(_compiled(name), args)):
+        t0 = time.perf_counter()
+        try:
+            return fallback(*args)
+        finally:
+            tiers.charge(name, time.perf_counter() - t0)
+    fn = _compiled(name)
+    if hasattr(fn, "py_func"):                   # (NUMBA_DISABLE_JIT: a plain function)
+        ensure(fn, *args)
+    return fn(*args)
 
 
 def _compiled(name: str) -> Any:

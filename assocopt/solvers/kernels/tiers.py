@@ -44,7 +44,7 @@ import types
 from typing import Any, Callable, Iterator
 
 __all__ = ["MODES", "LIMITS", "BUDGET_COLD", "BUDGET_CACHED", "mode", "set_mode",
-           "interpret", "plain", "compiled", "interpreted_seconds", "exhaust",
+           "interpret", "plain", "compiled", "interpreted_seconds", "exhaust", "charge",
            "reproducible"]
 
 MODES = ("auto", "compiled", "interpreted")
@@ -69,6 +69,9 @@ LIMITS: dict[str, float] = {
     "search.dfs": 20_000,                 # candidates; stops at the budget
     "batch.solve_batch": 40_000,          # candidates of all components; stops too
     "dominance.dominated_kernel": 300_000,  # candidates
+    # candidates; below, the numpy route of ``problems.components`` stands in for the
+    # plain twin (numpy: about 0.15 us a candidate; the twin would be 100x that)
+    "components.split_rows": 100_000,
     "sparse_lap.lap_edges": 300_000,      # edges
     "murty2d.murty": 200_000,             # solutions x matrix entries
     # candidates; a net grows with its cluster's width (dense 8 x 9: 0.11 s,
@@ -168,6 +171,13 @@ def exhaust(name: str) -> None:
     past its budget): it is compiled from the next call on."""
     with _LOCK:
         _SPENT[name] = max(_SPENT.get(name, 0.0), BUDGET_COLD)
+
+
+def charge(name: str, seconds: float) -> None:
+    """Count ``seconds`` of a numpy route that stood in for kernel ``name`` (see
+    :func:`assocopt.solvers.kernels.routed`) into its interpreted budget."""
+    with _LOCK:
+        _SPENT[name] = _SPENT.get(name, 0.0) + seconds
 
 
 def interpreted_seconds() -> dict[str, float]:

@@ -15,6 +15,7 @@ import numpy as np
 
 from ...model.solution import Status
 from ...problems.components import local_tuples, split, subproblem
+from ..kernels import routed
 from ...problems.problem import AssignmentProblem
 from ..base import SolveOptions, get_backend
 from .ascent import _State
@@ -120,7 +121,7 @@ def _by_components(problem: AssignmentProblem, pos: np.ndarray, st: _State,
         return None
     W = AssignmentProblem._build(problem.sizes, problem.tuples[pos], problem.costs[pos],
                                  problem.slack[pos], kind="sparse")
-    sp = split(W)
+    sp = split(W, routed)
     if sp.n < 2:
         return None
     T, csizes = local_tuples(W, sp.of_row, sp.n)

@@ -1,0 +1,80 @@
+"""Connected components of an S-D problem's candidates, compiled.
+
+The kernel of :func:`assocopt.problems.components.split`: a union-find over the real
+indices (constraint rows), each candidate joining the rows it covers, then the
+components labelled in the order of their smallest row (the labels scipy's
+``connected_components`` gives) and the candidates placed by a counting sort.  One
+pass instead of the numpy route's graph build, argsorts and bincounts: a gated N = 5
+scan of 16,600 candidates went 2.5 -> 0.2 ms.  Small problems take the numpy route
+(the kernel's plain twin would be slower than numpy).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from .jit import njit
+
+__all__ = ["split_rows"]
+
+
+@njit(cache=True, nogil=True)
+def _find(parent, r):
+    """Root of row ``r``, halving the path on the way."""
+    while parent[r] != r:
+        parent[r] = parent[parent[r]]
+        r = parent[r]
+    return r
+
+
+@njit(cache=True, nogil=True)
+def split_rows(R, E):
+    """``(n, of_row, of_cand, order, ptr, trivial)`` of the candidates' entry rows
+    ``R`` (K, N; -1 = dummy) over ``E`` rows, as :class:`~assocopt.problems.components.Split`
+    holds them (``order`` a stable sort of the candidates by component)."""
+    K, N = R.shape
+    parent = np.arange(E)
+    first = np.full(K, -1, np.int64)
+    cover = np.zeros(E, np.int64)
+    for k in range(K):
+        a = -1
+        for s in range(N):
+            r = R[k, s]
+            if r < 0:
+                continue
+            cover[r] += 1
+            if a < 0:
+                first[k] = r
+                a = _find(parent, r)
+                continue
+            b = _find(parent, r)
+            if b != a:                      # the larger root under the smaller
+                if b < a:
+                    a, b = b, a
+                parent[b] = a
+    label = np.full(E, -1, np.int64)
+    of_row = np.empty(E, np.int64)
+    n = 0
+    for r in range(E):
+        root = _find(parent, r)
+        if label[root] < 0:
+            label[root] = n
+            n += 1
+        of_row[r] = label[root]
+    of_cand = np.empty(K, np.int64)
+    ptr = np.zeros(n + 1, np.int64)
+    for k in range(K):
+        of_cand[k] = of_row[first[k]]
+        ptr[of_cand[k] + 1] += 1
+    for c in range(n):
+        ptr[c + 1] += ptr[c]
+    fill = ptr[:n].copy()
+    order = np.empty(K, np.int64)
+    for k in range(K):
+        c = of_cand[k]
+        order[fill[c]] = k
+        fill[c] += 1
+    trivial = np.ones(n, np.bool_)
+    for r in range(E):
+        if cover[r] > 1:
+            trivial[of_row[r]] = False
+    return n, of_row, of_cand, order, ptr, trivial
