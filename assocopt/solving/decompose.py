@@ -63,6 +63,26 @@ GROUPED = {"highs", "scipy", "ortools-cpsat", "ortools-mip", "cvxpy"}
 #: tuned on the public 3-AP instances.
 TRACKING_OPTIONS = {"local_search": False, "lap": "sparse", "recover_every": 5,
                     "stall_iter": 15, "stall_tol": 0.01}
+#: ... and without the dominance rule (``reduce=False``) at N >= 5 up to this many
+#: candidates: there the rule's splits (up to 2^(N-1) - 1 a candidate) cost more than
+#: the 10-25 % of candidates it drops saves.  Measured on the components above 700
+#: candidates of the N = 5-6 scans of benchmarks/sd_tracking.py (seeds 51-52, not
+#: the page's): 1,200-8,000 candidates 30-50 % faster without it (N = 6, n = 100,
+#: spacing 2: 12.9 -> 10.4 ms and 9.1 -> 6.8 ms for the 9-10 components of a scan),
+#: 37,000-57,000 level or faster (15.4 -> 11.2 ms; one 22.6 -> 23.7), while at N = 5
+#: 88,000-121,000 it is slower (60 -> 77 ms, 82 -> 96 ms).  At N = 3-4 the rule pays
+#: (N = 3, spacing 0.7: 29 ms with it, 36 without) and stays.
+NO_DOMINANCE_MAX = 60_000
+
+
+def tracking_options(problem: AssignmentProblem) -> dict[str, Any]:
+    """The ``lagrangian-exact`` options ``auto`` gives a problem with dummies:
+    :data:`TRACKING_OPTIONS`, and ``reduce=False`` where :data:`NO_DOMINANCE_MAX`
+    says."""
+    extra = dict(TRACKING_OPTIONS)
+    if problem.ndim >= 5 and problem.n_candidates <= NO_DOMINANCE_MAX:
+        extra["reduce"] = False
+    return extra
 
 
 def _full_grid(problem: AssignmentProblem) -> bool:
@@ -233,12 +253,12 @@ def _auto_choice(sub: AssignmentProblem) -> str:
 
 def _auto_options(problem: AssignmentProblem, solver: str, opts: SolveOptions
                   ) -> SolveOptions:
-    """``opts`` with :data:`TRACKING_OPTIONS` for ``lagrangian-exact`` on a problem
+    """``opts`` with :func:`tracking_options` for ``lagrangian-exact`` on a problem
     with dummies (else as they are)."""
     import dataclasses
     if solver != "lagrangian-exact" or not (problem.tuples == 0).any():
         return opts
-    return dataclasses.replace(opts, extra=dict(TRACKING_OPTIONS), parsed=False)
+    return dataclasses.replace(opts, extra=tracking_options(problem), parsed=False)
 
 
 def _defaults(opts: SolveOptions) -> SolveOptions:
