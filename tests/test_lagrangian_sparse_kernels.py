@@ -76,10 +76,28 @@ def _walk(fast, slow, seed: int, steps: int = 10) -> int:
 def test_compiled_route_equals_numpy(seed, N):
     p = _problem(seed, N)
     fast, slow = _pair(p)
-    if fast.uniform:
-        pytest.skip("uniform groups: the numpy fast path, not this route")
+    slow.uniform = False          # uniform groups too: against the general numpy code
     assert fast.kern is not None
     _walk(fast, slow, seed)
+
+
+@pytest.mark.parametrize("seed", range(6))
+@pytest.mark.parametrize("N", [3, 4, 5])
+def test_uniform_groups_take_the_compiled_route(seed, N):
+    """Every kept-axes pair holding the same tails (all tuples of a small grid, dummies
+    included): the compiled route runs there too, equal to the numpy code."""
+    rng = np.random.default_rng(seed)
+    sizes = tuple(int(v) for v in rng.integers(1, 3, size=N))
+    grids = np.meshgrid(*[np.arange(n + 1) for n in sizes], indexing="ij")
+    T = np.stack([g.ravel() for g in grids], axis=1)[1:]
+    c = np.round(rng.normal(0.0, 3.0, len(T)), 0 if seed % 2 else 3)
+    p = AssignmentProblem.sparse(sizes, T, c)
+    fast, slow = _pair(p)
+    assert fast.uniform and fast.kern is not None
+    slow.uniform = False
+    _walk(fast, slow, seed)
+    sol = solve(p, "lagrangian-exact", lap="sparse", local_search=False)
+    assert_optimal(p, sol)
 
 
 @pytest.mark.parametrize("N", [3, 4, 5, 6])
@@ -92,6 +110,7 @@ def test_recoveries_compared(N):
 @given(seed=st.integers(0, 10_000), N=st.integers(3, 6))
 def test_compiled_route_equals_numpy_drawn(seed, N):
     fast, slow = _pair(_problem(seed, N))
+    slow.uniform = False
     if fast.kern is not None:
         _walk(fast, slow, seed, steps=4)
 

@@ -1,8 +1,10 @@
 """The compiled route of the gated (sparse) Lagrangian relaxation.
 
-:class:`_Relaxation` on a gated problem with dummies (not a dense grid, groups of
-differing tails, ``lap="sparse"``, miss groups present: the tracking scans that
-``auto`` hands to ``lagrangian-exact`` with its tracking options) evaluates ``L(u)``
+:class:`_Relaxation` on a gated problem with dummies (not a dense grid,
+``lap="sparse"``, miss groups present: the tracking scans that ``auto`` hands to
+``lagrangian-exact`` with its tracking options, their components whose kept-axes
+pairs all hold the same tails included, where the numpy fast path for such groups
+cost 2.1 against 0.9 ms on three components of 300-700 candidates) evaluates ``L(u)``
 and recovers primal solutions by the kernels of
 :mod:`assocopt.solvers.kernels.sparse_relax` instead of about forty numpy calls per
 evaluation and a lexsort plus LAP per relaxed axis per recovery.  The kernels repeat
@@ -39,7 +41,7 @@ def sparse_kernels(rel: Any, result: type) -> "SparseKernels | None":
     """The compiled route for relaxation ``rel``, or None where the numpy code runs
     (module doc); ``result`` is the relaxation's evaluation type (``_Eval``: handed
     in, as the relaxation module imports this one)."""
-    if rel.grid or rel.uniform or rel.lap != "sparse" or not rel.has_miss or not rel.K \
+    if rel.grid or rel.lap != "sparse" or not rel.has_miss or not rel.K \
             or not rel.relaxed:
         return None
     if not compiled_route(rel.K):
