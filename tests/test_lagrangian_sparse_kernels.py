@@ -61,6 +61,8 @@ def _walk(fast, slow, seed: int, steps: int = 10) -> int:
     for _ in range(steps):
         a, b = fast.evaluate(u), slow.evaluate(u)
         _same_eval(a, b)
+        for x, y in zip(fast.fixing_bounds(u), slow.fixing_bounds(u)):   # fixing_duals
+            assert np.array_equal(x, y)
         ra, rb = fast.recover(u, a.chosen), slow.recover(u, b.chosen)
         assert (ra is None) == (rb is None)
         if ra is not None:
@@ -143,6 +145,10 @@ def test_twin_equals_compiled(seed):
     rargs = (k.c, k.U, k.u_off, k.sizes, u, k.nf) + k.groups + (out_c[3],)
     rc_, rp = tiers.compiled(RECOVER)(*rargs), tiers.plain(RECOVER)(*rargs)
     assert rc_[0] == rp[0] and np.array_equal(rc_[1], rp[1])
+    fargs = (out_c[1], out_c[2], out_c[7], out_c[8]) + k.lap[1:] + k.fix  # rc, gmin, cor, roc
+    fix = "fixing_duals.sparse_fixing"
+    for x, y in zip(tiers.compiled(fix)(*fargs), tiers.plain(fix)(*fargs)):
+        assert np.array_equal(x, y)
 
 
 def test_lap_without_misses_left_to_numpy():

@@ -31,6 +31,7 @@ __all__ = ["sparse_kernels", "compiled_route", "SparseKernels"]
 
 EVAL = "sparse_relax.sparse_eval"
 RECOVER = "sparse_relax.sparse_recover"
+FIXING = "fixing_duals.sparse_fixing"
 
 
 def _i64(a: Any) -> np.ndarray:
@@ -73,6 +74,7 @@ class SparseKernels:
         self.lap = (_i64(rel.gkey), self.na, self.nb, _i64(rel.pair_g), _i64(rel.pr),
                     _i64(rel.pc), _i64(rel.rm_g), _i64(rel.rm_i), _i64(rel.cm_g),
                     _i64(rel.cm_j))
+        self.fix = (_i64(rel.g_row), _i64(rel.g_col), _i64(rel.g_count), self.nf)
         self.fns: dict[str, Any] = {}
 
     def _fn(self, name: str, args: tuple) -> Any:
@@ -98,6 +100,20 @@ class SparseKernels:
         value = float(gmin[chosen].sum()) + free_value + float(upad.sum())
         return self.result(value, sel, g, chosen, rc, gmin, Assignment2D(cor, roc, "sparse"),
                      free_value)
+
+    def fixing(self, ev: Any, upad: np.ndarray) -> tuple[np.ndarray, np.ndarray, float]:
+        """``_Relaxation.fixing_bounds`` from the evaluation ``ev`` at ``upad`` (the
+        potentials and reduced costs by :mod:`..kernels.fixing_duals`)."""
+        asg = ev.assignment
+        args = (ev.rc, ev.gmin, _i64(asg.col_of_row), _i64(asg.row_of_col)) + \
+            self.lap[1:] + self.fix
+        alpha, beta, red = self._fn(FIXING, args)(*args)
+        const = ev.free_value + float(upad.sum())     # summed as the numpy code does
+        l_dual = float(alpha.sum() + beta.sum()) + const
+        lb = l_dual + red
+        nf = self.nf
+        lb[:nf] = np.maximum(lb[:nf], ev.value + red[:nf])
+        return lb, red, l_dual
 
     def recover(self, upad: np.ndarray, chosen: np.ndarray) -> tuple[bool, Any]:
         """``(True, _Relaxation.recover's answer)``, or ``(False, None)``: left to the

@@ -342,8 +342,9 @@ class _Relaxation:
         in the relaxation), and ``lb[k] >= base + red[k]`` bounds any ``S`` holding k.
         """
         ev = self.evaluate(upad, full_rc=True)
-        rc, gmin = ev.rc, ev.gmin
-        na, nb = self.na, self.nb
+        if self.kern is not None:               # gated: one compiled call
+            return self.kern.fixing(ev, upad)
+        rc, gmin, na, nb = ev.rc, ev.gmin, self.na, self.nb
         cor, roc = ev.assignment.col_of_row, ev.assignment.row_of_col
         pw = gmin[self.pair_g]
         if not self.has_miss:
@@ -362,8 +363,7 @@ class _Relaxation:
         alpha, beta = assignment_duals(size, er, ec, ew, match, max_sweeps=max(50, size))
         const = ev.free_value + float(upad.sum())
         l_dual = float(alpha.sum() + beta.sum()) + const
-        nf = self.nf
-        red = np.empty(self.K)
+        nf, red = self.nf, np.empty(self.K)
         red[:nf] = np.maximum(rc[:nf], 0.0)
         if self.G:
             grp = np.repeat(np.arange(self.G), self.g_count)
