@@ -135,7 +135,7 @@ def test_components_counted(p):
 @given(side_by_side())
 def test_split_kernel_equals_numpy_route(p):
     """The union-find kernel (compiled, and as its plain twin) gives the numpy route's
-    split, labels and candidate order included."""
+    split, labels and candidate order included; so does the relabelling kernel."""
     pytest.importorskip("numba")
     from assocopt.problems.components import split_rows
     from assocopt.solvers.kernels import tiers
@@ -147,6 +147,12 @@ def test_split_kernel_equals_numpy_route(p):
         assert got[0] == want[0]
         for a, b in zip(got[1:], want[1:]):
             assert np.array_equal(a, b)
+    from assocopt.solvers.kernels.components import local_rows
+    T, sizes = local_tuples(p, want[1], want[0])
+    axis = np.repeat(np.arange(p.ndim), p.sizes).astype(np.int64)
+    for fn in (local_rows, tiers.plain("components.local_rows")):
+        T2, sizes2 = fn(R, want[1], want[0], axis)
+        assert np.array_equal(T, T2) and np.array_equal(sizes, sizes2)
 
 
 def test_split_routes_by_the_tier_rule(monkeypatch):

@@ -85,20 +85,32 @@ def split_rows(R: np.ndarray, E: int) -> tuple:
     return n, of_row, of_cand, order, ptr, trivial
 
 
-def local_tuples(problem: AssignmentProblem, part_of_row: np.ndarray, n_parts: int
-                 ) -> tuple[np.ndarray, np.ndarray]:
+def local_tuples(problem: AssignmentProblem, part_of_row: np.ndarray, n_parts: int,
+                 run: Callable | None = None) -> tuple[np.ndarray, np.ndarray]:
     """Each candidate's tuple relabelled within its part (parts: groups of whole
     components), ``(K, N)``, and the parts' axis sizes, ``(n_parts, N)``: the real
-    indices of a part on axis s become ``1..n_s`` in their original order."""
+    indices of a part on axis s become ``1..n_s`` in their original order.  ``run``:
+    as for :func:`split` (the kernel ``local_rows``, same answer)."""
     N = problem.ndim
     axis_of_row = np.repeat(np.arange(N), problem.sizes)
+    if run is not None:
+        R = np.ascontiguousarray(problem.entry_rows, np.int64)
+        return run("components.local_rows", _local_rows, R,
+                   np.ascontiguousarray(part_of_row, np.int64), int(n_parts),
+                   axis_of_row.astype(np.int64), work=len(R))
+    return _local_rows(problem.entry_rows, part_of_row, n_parts, axis_of_row)
+
+
+def _local_rows(R: np.ndarray, part_of_row: np.ndarray, n_parts: int,
+                axis_of_row: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """:func:`local_tuples` in numpy."""
+    N = R.shape[1]
     key = part_of_row * N + axis_of_row
     order = np.argsort(key, kind="stable")
     counts = np.bincount(key, minlength=n_parts * N)
     start = np.concatenate([[0], np.cumsum(counts)[:-1]])
     local = np.empty(len(key), np.int64)
     local[order] = np.arange(len(key)) - start[key[order]] + 1
-    R = problem.entry_rows
     T = np.where(R >= 0, local[np.maximum(R, 0)], 0)
     return T, counts.reshape(n_parts, N)
 

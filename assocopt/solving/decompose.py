@@ -188,7 +188,7 @@ def _solve_parts(problem: AssignmentProblem, sp: Split, todo: np.ndarray,
     kernel settled."""
     from .choice import BNB_MAX_KEPT, _numba_installed, bnb_cap
 
-    T, csizes = local_tuples(problem, sp.of_row, sp.n)
+    T, csizes = local_tuples(problem, sp.of_row, sp.n, routed)
     plain_auto = requested == "auto"
     single, grouped, n_batched = todo, todo[:0], 0
     spent = np.zeros(sp.n, bool)              # node budget spent in the batch
@@ -199,8 +199,7 @@ def _solve_parts(problem: AssignmentProblem, sp: Split, todo: np.ndarray,
             fits = (top2.sum(axis=1) <= MAX_KEPT) & \
                 ((top2[:, 0] + 1) * (top2[:, 1] + 1) <= MAX_DENSE)
         else:
-            gated = np.bincount(sp.of_cand, weights=(T == 0).any(axis=1),
-                                minlength=sp.n)[todo] > 0
+            gated = np.bincount(sp.of_cand[_has_dummy(T)], minlength=sp.n)[todo] > 0
             fits = (sp.sizes[todo] <= bnb_cap(gated)) & (top2.sum(axis=1) <= BNB_MAX_KEPT)
         from ..solvers.bnb.batch import solve_components
         left = _left(opts, t0)()
@@ -230,6 +229,15 @@ def _solve_parts(problem: AssignmentProblem, sp: Split, todo: np.ndarray,
         o = _auto_options(sub, solver, _defaults(opts)) if plain_auto else opts
         out.add_raw(_solve_one(sub, solver, o, remaining), cand, solver, count)
     return n_batched
+
+
+def _has_dummy(T: np.ndarray) -> np.ndarray:
+    """Per candidate, whether its tuple has a dummy index, column by column (``(T ==
+    0).any(axis=1)`` cost 10x more on a 22,000-candidate N = 6 scan: 0.4 ms)."""
+    out = T[:, 0] == 0
+    for s in range(1, T.shape[1]):
+        out |= T[:, s] == 0
+    return out
 
 
 def _group(T: np.ndarray, csizes: np.ndarray, sp: Split, comps: np.ndarray

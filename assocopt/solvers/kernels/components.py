@@ -78,3 +78,25 @@ def split_rows(R, E):
         if cover[r] > 1:
             trivial[of_row[r]] = False
     return n, of_row, of_cand, order, ptr, trivial
+
+
+@njit(cache=True, nogil=True)
+def local_rows(R, part_of_row, n_parts, axis_of_row):
+    """``(T, counts)`` of :func:`assocopt.problems.components.local_tuples`: each entry
+    row of ``R`` (K, N; -1 a dummy) renumbered ``1..`` within its part and axis, in
+    row order (0 for a dummy), and the parts' axis sizes ``(n_parts, N)``."""
+    K, N = R.shape
+    E = part_of_row.shape[0]
+    counts = np.zeros((n_parts, N), np.int64)
+    local = np.empty(E, np.int64)
+    for r in range(E):
+        p, s = part_of_row[r], axis_of_row[r]
+        counts[p, s] += 1
+        local[r] = counts[p, s]
+    T = np.zeros((K, N), np.int64)
+    for k in range(K):
+        for s in range(N):
+            r = R[k, s]
+            if r >= 0:
+                T[k, s] = local[r]
+    return T, counts

@@ -124,7 +124,7 @@ def _by_components(problem: AssignmentProblem, pos: np.ndarray, st: _State,
     sp = split(W, routed)
     if sp.n < 2:
         return None
-    T, csizes = local_tuples(W, sp.of_row, sp.n)
+    T, csizes = local_tuples(W, sp.of_row, sp.n, routed)
     bnb, sel = get_backend("bnb"), []
     token = _NESTED.set(True)
     try:
