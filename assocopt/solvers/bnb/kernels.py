@@ -19,7 +19,7 @@ the ascent only makes it tight.
 
 from typing import Any
 
-from ..kernels import ensure, pick, spent, uninterrupted  # noqa: F401  (compile clock; Ctrl-C)
+from ..kernels import ensure, pick, pick_fixed, spent, uninterrupted  # noqa: F401  (clock; Ctrl-C)
 from ..kernels.outcomes import BUDGET, COMPLETE, INFEASIBLE, PROVEN, STOPPED  # noqa: F401
 
 #: The kernels, by the module of :mod:`assocopt.solvers.kernels` that holds them:
@@ -59,7 +59,8 @@ def cached(*kernels: Any) -> bool:
 
 
 def run_tiered(kernel: str, args: tuple, stop: Any, *, work: float,
-               deadline: float | None = None, inline: bool = False) -> tuple[Any, bool]:
+               deadline: float | None = None, inline: bool = False,
+               fixed: bool = False) -> tuple[Any, bool]:
     """:func:`assocopt.solvers.interruptible.run_stoppable` of the kernel named ``kernel`` (``"driver.solve"``) by
     the route :func:`assocopt.solvers.kernels.pick` chooses for ``work``.
 
@@ -67,7 +68,8 @@ def run_tiered(kernel: str, args: tuple, stop: Any, *, work: float,
     ends: a kernel may write its answer into one) and gets the rest of the kernel's
     interpreted budget as a deadline of its own: a small problem that turns out hard
     runs past it, and is then solved again compiled, from the original arguments, the
-    compilation not counted against ``deadline``."""
+    compilation not counted against ``deadline``.  ``fixed``: the call site's argument
+    types never change (:func:`assocopt.solvers.kernels.pick_fixed`)."""
     import time
 
     import numpy as np
@@ -75,7 +77,7 @@ def run_tiered(kernel: str, args: tuple, stop: Any, *, work: float,
     from ..interruptible import run_stoppable
     from ..kernels import tiers
 
-    fn = pick(kernel, *args, work=work)
+    fn = (pick_fixed if fixed else pick)(kernel, *args, work=work)
     if not getattr(fn, "interpreted", False):               # compiled
         return run_stoppable(fn, args, stop, deadline=deadline, inline=inline)
     cap = time.perf_counter() + tiers.budget_left(kernel)

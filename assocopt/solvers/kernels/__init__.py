@@ -39,7 +39,7 @@ from typing import Any, Iterator
 
 import numpy as np
 
-__all__ = ["ensure", "pick", "routed", "spent", "announced", "defer_interrupt",
+__all__ = ["ensure", "pick", "pick_fixed", "routed", "spent", "announced", "defer_interrupt",
            "uninterrupted"]
 
 _LOG = logging.getLogger("assocopt")
@@ -151,6 +151,27 @@ def pick(kernel: Any, *args: Any, work: float) -> Any:
     if hasattr(kernel, "py_func"):               # (NUMBA_DISABLE_JIT: a plain function)
         ensure(kernel, *args)
     return kernel
+
+
+def pick_fixed(kernel: str, *args: Any, work: float) -> Any:
+    """:func:`pick` for a call site whose argument types never change (arrays it builds
+    itself, with fixed dtypes): once the compiled kernel has been handed out there, it
+    is returned at once under the same route rule (:func:`.tiers.mode`), without
+    typing the arguments again (a window search asked for four kernels at 5-14 us
+    each; a gated scan's solve makes about 80 such asks)."""
+    from . import tiers
+
+    key = (kernel, tiers.mode())
+    fn = _FIXED.get(key)
+    if fn is None:
+        fn = pick(kernel, *args, work=work)
+        if getattr(fn, "overloads", None):           # compiled (not a plain twin)
+            _FIXED[key] = fn
+    return fn
+
+
+#: Compiled kernels :func:`pick_fixed` has handed out, by (name, route rule).
+_FIXED: dict[tuple[str, str], Any] = {}
 
 
 def routed(kernel: str, fallback: Any, *args: Any, work: float) -> Any:

@@ -82,8 +82,8 @@ class SparseKernels:
         change within one (the ascent calls hundreds of times, and ``pick`` typing 18
         arguments cost about as much as a small evaluation)."""
         if name not in self.fns:
-            from ..kernels import pick
-            self.fns[name] = pick(name, *args, work=np.inf)
+            from ..kernels import pick_fixed
+            self.fns[name] = pick_fixed(name, *args, work=np.inf)
         return self.fns[name]
 
     def evaluate(self, upad: np.ndarray) -> Any:

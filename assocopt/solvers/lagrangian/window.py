@@ -102,22 +102,21 @@ def _compiled_search(problem: AssignmentProblem, pos: np.ndarray, red: np.ndarra
     sizes = np.asarray(problem.sizes, np.int64)
     args = (T, problem.row_offsets, sizes, c, 0, 1)
     work = len(pos)                          # small: the kernels may run interpreted
-    G, ptr, lst, _, axis_of, _, _ = kern.pick(kern.name("prepare"), *args,
-                                              work=work)(*args)
+    G, ptr, lst, _, axis_of, _, _ = kern.pick_fixed(kern.name("prepare"), *args,
+                                                    work=work)(*args)
     rp = np.ascontiguousarray(red, np.float64)
-    limit = kern.pick(kern.name("improve_limit"), cap, integer, OPT_TOL,
-                      work=work)(cap, integer, OPT_TOL)
-    sptr, slst = kern.pick(kern.name("sort_lists"), ptr, lst, rp, limit - base,
-                           work=work)(ptr, lst, rp, limit - base)
+    limit = kern.pick_fixed(kern.name("improve_limit"), cap, integer, OPT_TOL,
+                            work=work)(cap, integer, OPT_TOL)
+    sptr, slst = kern.pick_fixed(kern.name("sort_lists"), ptr, lst, rp, limit - base,
+                                 work=work)(ptr, lst, rp, limit - base)
     best = np.full(problem.n_rows + 1, -1, np.int64)
     from ..interruptible import new_stop
 
     stop = new_stop()
     args = (G, c, rp, base, sptr, slst, axis_of, problem.ndim, integer, OPT_TOL, cap,
             best, -1, node_limit, stop, float(floor))
-    kern.pick(kern.name("dfs"), *args, work=work)     # compile now (timed apart)
     (out, _, n, _), _ = kern.run_tiered(kern.name("dfs"), args, stop, work=work,
-                                        inline=node_limit <= 20_000)
+                                        inline=node_limit <= 20_000, fixed=True)
     return (pos[best[:n]] if n > 0 else None), out == kern.COMPLETE
 
 
