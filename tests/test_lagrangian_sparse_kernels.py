@@ -209,3 +209,37 @@ def test_bnb_cap_follows_the_route(monkeypatch):
     monkeypatch.setattr(tiers, "_MODE", ["interpreted"])
     assert choice.bnb_cap(np.array([True, False])).tolist() == \
         [choice.BNB_MAX_GATED, choice.BNB_MAX_CANDIDATES]
+
+
+_LAYOUT = ("pos", "T", "c", "nf", "g_start", "g_count", "gkey", "pair_g", "pr", "pc",
+           "rm_g", "rm_i", "cm_g", "cm_j", "g_row", "g_col", "G", "has_miss", "uniform")
+
+
+@settings(max_examples=40, deadline=None)
+@given(seed=st.integers(0, 10_000), N=st.integers(3, 6))
+def test_compiled_layout_equals_numpy(seed, N):
+    """The candidate layout and starting multipliers of the compiled route
+    (:mod:`assocopt.solvers.kernels.groups`) equal the numpy code's, dtypes included,
+    and the plain twins give the compiled answers."""
+    from assocopt.solvers.kernels import tiers
+    from assocopt.solvers.lagrangian.relaxation import _Relaxation
+    p = _problem(seed, N)
+    args = (p.sizes, p.tuples, p.costs, p.kept_axes(None), "sparse")
+    with pytest.MonkeyPatch.context() as mp:
+        mp.setattr(tiers, "_MODE", ["compiled"])
+        a = _Relaxation(*args)
+        ua = a.initial_multipliers()
+        mp.setattr(tiers, "_MODE", ["interpreted"])
+        b = _Relaxation(*args)
+        ub = b.initial_multipliers()
+    for name in _LAYOUT:
+        x, y = np.asarray(getattr(a, name)), np.asarray(getattr(b, name))
+        assert x.dtype == y.dtype and np.array_equal(x, y), name
+    assert all(np.array_equal(x, y) for x, y in zip(a.uidx, b.uidx))
+    assert np.array_equal(ua, ub)
+    a0, b0 = p.kept_axes(None)
+    largs = (np.ascontiguousarray(p.tuples), p.costs, a0, b0, p.sizes[a0], p.sizes[b0],
+             np.asarray(a.relaxed, np.int64), a.u_off)
+    for x, y in zip(tiers.compiled("groups.layout")(*largs),
+                    tiers.plain("groups.layout")(*largs)):
+        assert np.array_equal(x, y)

@@ -67,7 +67,8 @@ class SparseKernels:
         self.result = result
         self.nf, self.na, self.nb = int(rel.nf), int(rel.na), int(rel.nb)
         self.c = np.ascontiguousarray(rel.c, np.float64)
-        self.U = _i64(np.stack(rel.uidx))       # multiplier slot, per relaxed axis
+        # multiplier slot, per relaxed axis (the compiled layout's own array if any)
+        self.U = rel.U_all if rel.U_all is not None else _i64(np.stack(rel.uidx))
         self.u_off = _i64(rel.u_off)
         self.sizes = _i64([rel.sizes[r] for r in rel.relaxed])
         self.groups = (_i64(rel.g_start), _i64(rel.g_count))

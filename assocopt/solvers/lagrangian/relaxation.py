@@ -14,12 +14,12 @@ from typing import Any
 import numpy as np
 
 from ...runtime.errors import InvalidProblemError
-from ...problems.indexing import real_counts
 from ...problems.problem import AssignmentProblem
 from ..base import module_installed
 from ..twod.lap import (Assignment2D, LapInfeasibleError, assign_with_misses, assignment_duals,
                    linear_assignment)
 from .compiled_sparse import sparse_kernels
+from .layout import group_layout, initial_shares
 
 
 def _numba_installed(work: float = 0.0) -> bool:
@@ -74,43 +74,21 @@ class _Relaxation:
         self.relaxed = [s for s in range(len(sizes)) if s not in keep]
         na, nb = sizes[a], sizes[b]
         self.na, self.nb = na, nb
-        key = T[:, a] * (nb + 1) + T[:, b]
         K = len(c)
-        if K < 2 or bool((key[1:] >= key[:-1]).all()):     # dense input: already sorted
-            self.pos, self.T, self.c = np.arange(K), T, c
-        else:
-            order = np.argsort(key, kind="stable")
-            self.pos, self.T, self.c = order, T[order], c[order]
-            key = key[order]
         self.K = K
         blocks = [sizes[r] + 1 for r in self.relaxed]
         self.u_off = (np.cumsum([0] + blocks[:-1]) if blocks else np.zeros(0)).astype(np.int64)
         self.u_len = int(sum(blocks))
-        self.uidx = [self.u_off[t] + self.T[:, r] for t, r in enumerate(self.relaxed)]
-        # groups
-        starts = np.concatenate(([0], np.flatnonzero(key[1:] != key[:-1]) + 1)) if K \
-            else np.zeros(0, np.int64)
-        gkey = key[starts]
-        counts = np.diff(np.append(starts, K)).astype(np.int64)
-        has_free = K > 0 and gkey[0] == 0
-        self.nf = int(counts[0]) if has_free else 0
-        if has_free:
-            starts, gkey, counts = starts[1:], gkey[1:], counts[1:]
-        self.g_start, self.g_count = starts.astype(np.int64), counts
+        (self.pos, self.T, self.c, self.uidx, self.nf, self.g_start, self.g_count, gkey,
+         self.pair_g, self.pr, self.pc, self.rm_g, self.rm_i, self.cm_g, self.cm_j,
+         self.g_row, self.g_col, self.U_all) = group_layout(T, c, keep, sizes, self.relaxed,
+                                                            self.u_off, lap)
+        counts = self.g_count
         G = len(gkey)
         self.G = G
-        gi, gj = gkey // (nb + 1), gkey % (nb + 1)
-        pair, rmiss, cmiss = (gi > 0) & (gj > 0), (gi > 0) & (gj == 0), (gi == 0) & (gj > 0)
-        self.pair_g = np.flatnonzero(pair)
-        self.pr, self.pc = gi[pair] - 1, gj[pair] - 1
-        self.rm_g, self.rm_i = np.flatnonzero(rmiss), gi[rmiss] - 1
-        self.cm_g, self.cm_j = np.flatnonzero(cmiss), gj[cmiss] - 1
         self.has_miss = bool(len(self.rm_g) or len(self.cm_g))
         self.gkey = gkey                      # sorted: group id = position
         self.g_range = np.arange(G)
-        # node of each group in the (augmented) 2-D graph, for the duals
-        self.g_row = np.where(gi > 0, gi - 1, na + gj - 1)
-        self.g_col = np.where(gj > 0, gj - 1, nb + gi - 1)
         # uniform fast path: every group holds the same relaxed-axes tails (dense tensors)
         self.uniform = self.simple = self.grid = False
         if G and (counts == counts[0]).all() and K - self.nf == G * counts[0]:
@@ -145,16 +123,9 @@ class _Relaxation:
     def initial_multipliers(self) -> np.ndarray:
         """Each relaxed index gets the least per-index share ``c_k / (real indices of
         k)`` among the candidates that cover it: a start close to a dual solution."""
-        upad = np.zeros(self.u_len)
         if not self.K or not self.uidx:
-            return upad
-        share = self.c / np.maximum(real_counts(self.T), 1)
-        best = np.full(self.u_len, np.inf)
-        for ui in self.uidx:
-            np.minimum.at(best, ui, share)
-        best[~np.isfinite(best)] = 0.0
-        best[self.u_off] = 0.0
-        return best
+            return np.zeros(self.u_len)
+        return initial_shares(self)
 
     # ------------------------------------------------------------ evaluation
     def reduced_costs(self, upad: np.ndarray) -> np.ndarray:
