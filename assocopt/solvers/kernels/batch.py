@@ -5,7 +5,8 @@ each (:mod:`assocopt.solving.decompose`); one ``solve()`` per component would co
 in Python than the search itself.  :func:`solve_batch` takes the components'
 candidates concatenated (each component's tuples relabelled to its own indices
 ``1..n_cs``) and runs, for each, the same steps as the ``bnb`` back end: ``prepare``
-then the driver's ascent and search, with the two largest axes kept.
+then the driver's ascent and search (:mod:`.driver`, :func:`.search.dfs`), with the
+two largest axes kept.
 """
 
 from __future__ import annotations

@@ -1,5 +1,5 @@
 """The ``bnb`` driver: subgradient ascent with N = 3 primal recovery and periodic
-searches, then the final search; one compiled call per problem."""
+searches (:func:`.search.dfs`), then the final search; one compiled call per problem."""
 
 from __future__ import annotations
 

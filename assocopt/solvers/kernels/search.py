@@ -13,14 +13,21 @@ from .outcomes import BUDGET, COMPLETE  # noqa: E402,F401  (dfs() outcomes)
 
 
 @njit(cache=True)
-def _mark(G, ptr, lst, blocked, k, n_axes, delta):
+def _mark(G, ptr, lst, blocked, k, n_axes, delta, rp, cut):
     """Add ``delta`` to the blocked count of every candidate sharing a row with ``k``
-    (``k`` chosen: +1; undone: -1), so that "is it free" is one load."""
+    whose reduced cost is below ``cut`` (``k`` chosen: +1; undone: -1, with the same
+    ``cut``), so that "is it free" is one load.  The lists are sorted by reduced
+    cost and every read below ``k``'s choice is of a candidate under the slack then,
+    which only shrinks (the incumbent's limit falls, the partial cost grows): the
+    counts of the others are never read while ``k`` is chosen, so they are skipped."""
     for s in range(n_axes):
         e = G[k, s]
         if e >= 0:
             for p in range(ptr[e], ptr[e + 1]):
-                blocked[lst[p]] += delta
+                q = lst[p]
+                if rp[q] >= cut:
+                    break
+                blocked[q] += delta
 
 
 @njit(cache=True)
@@ -81,6 +88,7 @@ def dfs(G, c, rp, base, ptr, lst, axis_of, n_axes, int_costs, tol, ub, best_sel,
     stack_e = np.empty(E + 1, np.int64)
     stack_p = np.empty(E + 1, np.int64)
     stack_k = np.full(E + 1, -1, np.int64)
+    stack_s = np.zeros(E + 1)                       # the cut of each choice's marks
     limit = improve_limit(ub, int_costs, tol)
     nodes = 0
     ncov = 0
@@ -100,7 +108,7 @@ def dfs(G, c, rp, base, ptr, lst, axis_of, n_axes, int_costs, tol, ub, best_sel,
                 if e >= 0:
                     covered[e] = False
                     ncov -= 1
-            _mark(G, ptr, lst, blocked, k, n_axes, -1)
+            _mark(G, ptr, lst, blocked, k, n_axes, -1, rp, stack_s[d])
             acc -= rp[k]
             stack_k[d] = -1
         e = stack_e[d]
@@ -125,8 +133,9 @@ def dfs(G, c, rp, base, ptr, lst, axis_of, n_axes, int_costs, tol, ub, best_sel,
             if e >= 0:
                 covered[e] = True
                 ncov += 1
-        _mark(G, ptr, lst, blocked, found, n_axes, 1)
         acc += rp[found]
+        stack_s[d] = limit - base - acc          # the slack below this choice, at most
+        _mark(G, ptr, lst, blocked, found, n_axes, 1, rp, stack_s[d])
         stack_k[d] = found
         nodes += 1
         if ncov == E:                               # leaf: an exact cover
