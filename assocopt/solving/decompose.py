@@ -191,8 +191,8 @@ def _solve_parts(problem: AssignmentProblem, sp: Split, todo: np.ndarray,
     T, csizes = local_tuples(problem, sp.of_row, sp.n, routed)
     plain_auto = requested == "auto"
     single, grouped, n_batched = todo, todo[:0], 0
-    spent = np.zeros(sp.n, bool)              # node budget spent in the batch
-    if (plain_auto or name == "bnb") and _numba_installed():
+    batch = (plain_auto or name == "bnb") and _numba_installed()
+    if batch:
         top2 = np.sort(csizes[todo], axis=1)[:, -2:]
         if name == "bnb":         # bnb asked for: all that its kernels take
             from ..solvers.bnb.backend import MAX_DENSE, MAX_KEPT
@@ -208,24 +208,24 @@ def _solve_parts(problem: AssignmentProblem, sp: Split, todo: np.ndarray,
         bnb_opts = opts if name == "bnb" else _defaults(opts)
         redo = solve_components(problem, T, csizes, sp, todo[fits], bnb_opts, left, out)
         n_batched = int(fits.sum()) - len(redo)
-        spent[redo] = True
         single = np.concatenate([redo, todo[~fits]]).astype(np.int64)
     elif name in GROUPED:
         small = sp.sizes[todo] <= GROUP_MAX
         single, grouped = todo[~small], todo[small]
-    jobs = [(csizes[c], sp.order[sp.ptr[c]:sp.ptr[c + 1]], 1, spent[c]) for c in single]
+    jobs = [(csizes[c], sp.order[sp.ptr[c]:sp.ptr[c + 1]], 1) for c in single]
     if len(grouped):
-        jobs.append(_group(T, csizes, sp, grouped) + (False,))
-    for sizes, cand, count, again in jobs:
+        jobs.append(_group(T, csizes, sp, grouped))
+    for sizes, cand, count in jobs:
         remaining = _left(opts, t0)()
         if remaining is not None and remaining <= 0:
             out.add(Status.TIME_LIMIT, None, None, name, count,
                     "time limit reached before this component")
             continue
         sub = _subproblem(problem, T, sizes, cand)
-        solver = _auto_choice(sub) if plain_auto else name
-        if plain_auto and again:              # bnb's node budget ran out on it
-            solver = "lagrangian-exact"
+        # with the batch: what it left is past bnb's caps (choose_solver would say
+        # lagrangian-exact) or spent bnb's node budget
+        solver = ("lagrangian-exact" if batch else _auto_choice(sub)) if plain_auto \
+            else name
         o = _auto_options(sub, solver, _defaults(opts)) if plain_auto else opts
         out.add_raw(_solve_one(sub, solver, o, remaining), cand, solver, count)
     return n_batched
@@ -266,7 +266,16 @@ def _auto_options(problem: AssignmentProblem, solver: str, opts: SolveOptions
     import dataclasses
     if solver != "lagrangian-exact" or not (problem.tuples == 0).any():
         return opts
-    return dataclasses.replace(opts, extra=tracking_options(problem), parsed=False)
+    extra = tracking_options(problem)
+    key = tuple(sorted(extra.items()))
+    if key not in _PARSED:                    # parsed once (a component's solve
+        from ..solvers.base import get_backend   # parsed them again: 10 us)
+        _PARSED[key] = get_backend("lagrangian-exact").parse_options(extra)
+    return dataclasses.replace(opts, extra=_PARSED[key], parsed=True)
+
+
+#: :func:`tracking_options` parsed by the back end, by their items.
+_PARSED: dict[tuple, dict[str, Any]] = {}
 
 
 def _defaults(opts: SolveOptions) -> SolveOptions:
