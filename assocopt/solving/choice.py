@@ -45,6 +45,11 @@ BNB_MAX_GATED = 2_000
 #: the components of every setting's seed 51 (not tuned on): 700-1,000 candidates
 #: 25.6 ms against 15.1 (9 components), 1,000-1,500: 69.3 against 24.3 (13), 500-700:
 #: 18.0 against 15.9 (10), ``bnb`` ahead below 500 (on 200 of 201 components).
+#: Checked again once the relaxation's layout, fixing bounds and window search had
+#: lost most of their Python overhead (seeds 51-52 of the N = 3-6 settings): alone,
+#: ``lagrangian-exact`` was ahead from about 400-600 candidates, but on whole scans
+#: caps of 400 and 500 were level with 700 or slower (the batch has no per-component
+#: overhead), so it stays.
 BNB_MAX_GATED_COMPILED = 700
 
 
