@@ -52,11 +52,13 @@ def split(problem: AssignmentProblem, run: Callable | None = None) -> Split:
     ``run``: :func:`assocopt.solvers.kernels.routed` (the solvers pass it), which runs
     the compiled kernel :func:`assocopt.solvers.kernels.components.split_rows` where
     that costs less, else the numpy route below (same answer)."""
-    R = problem.entry_rows
+    E = problem.n_rows
     if run is None:
-        return Split(*split_rows(R, problem.n_rows))
-    return Split(*run("components.split_rows", split_rows,
-                      np.ascontiguousarray(R, np.int64), problem.n_rows, work=len(R)))
+        return Split(*split_rows(problem.entry_rows, E))
+    # the kernel reads the tuples (no entry-row array built); numpy reads the rows
+    return Split(*run("components.split_rows",
+                      lambda T, off, E: split_rows(problem.entry_rows, E),
+                      problem.tuples, problem.row_offsets, E, work=problem.n_candidates))
 
 
 def split_rows(R: np.ndarray, E: int) -> tuple:
@@ -94,10 +96,11 @@ def local_tuples(problem: AssignmentProblem, part_of_row: np.ndarray, n_parts: i
     N = problem.ndim
     axis_of_row = np.repeat(np.arange(N), problem.sizes)
     if run is not None:
-        R = np.ascontiguousarray(problem.entry_rows, np.int64)
-        return run("components.local_rows", _local_rows, R,
+        return run("components.local_rows",
+                   lambda T, off, *rest: _local_rows(problem.entry_rows, *rest),
+                   problem.tuples, problem.row_offsets,
                    np.ascontiguousarray(part_of_row, np.int64), int(n_parts),
-                   axis_of_row.astype(np.int64), work=len(R))
+                   axis_of_row.astype(np.int64), work=problem.n_candidates)
     return _local_rows(problem.entry_rows, part_of_row, n_parts, axis_of_row)
 
 

@@ -27,20 +27,21 @@ def _find(parent, r):
 
 
 @njit(cache=True, nogil=True)
-def split_rows(R, E):
-    """``(n, of_row, of_cand, order, ptr, trivial)`` of the candidates' entry rows
-    ``R`` (K, N; -1 = dummy) over ``E`` rows, as :class:`~assocopt.problems.components.Split`
-    holds them (``order`` a stable sort of the candidates by component)."""
-    K, N = R.shape
+def split_rows(T, off, E):
+    """``(n, of_row, of_cand, order, ptr, trivial)`` of the candidate tuples ``T``
+    (K, N; 0 = dummy; real index i of axis s is row ``off[s] + i - 1``) over ``E``
+    rows, as :class:`~assocopt.problems.components.Split` holds them (``order`` a
+    stable sort of the candidates by component)."""
+    K, N = T.shape
     parent = np.arange(E)
     first = np.full(K, -1, np.int64)
     cover = np.zeros(E, np.int64)
     for k in range(K):
         a = -1
         for s in range(N):
-            r = R[k, s]
-            if r < 0:
+            if T[k, s] <= 0:
                 continue
+            r = off[s] + T[k, s] - 1
             cover[r] += 1
             if a < 0:
                 first[k] = r
@@ -81,11 +82,12 @@ def split_rows(R, E):
 
 
 @njit(cache=True, nogil=True)
-def local_rows(R, part_of_row, n_parts, axis_of_row):
-    """``(T, counts)`` of :func:`assocopt.problems.components.local_tuples`: each entry
-    row of ``R`` (K, N; -1 a dummy) renumbered ``1..`` within its part and axis, in
-    row order (0 for a dummy), and the parts' axis sizes ``(n_parts, N)``."""
-    K, N = R.shape
+def local_rows(T0, off, part_of_row, n_parts, axis_of_row):
+    """``(T, counts)`` of :func:`assocopt.problems.components.local_tuples`: each real
+    index of the tuples ``T0`` (K, N; its row ``off[s] + i - 1``) renumbered ``1..``
+    within its part and axis, in row order (0 for a dummy), and the parts' axis sizes
+    ``(n_parts, N)``."""
+    K, N = T0.shape
     E = part_of_row.shape[0]
     counts = np.zeros((n_parts, N), np.int64)
     local = np.empty(E, np.int64)
@@ -96,7 +98,6 @@ def local_rows(R, part_of_row, n_parts, axis_of_row):
     T = np.zeros((K, N), np.int64)
     for k in range(K):
         for s in range(N):
-            r = R[k, s]
-            if r >= 0:
-                T[k, s] = local[r]
+            if T0[k, s] > 0:
+                T[k, s] = local[off[s] + T0[k, s] - 1]
     return T, counts
