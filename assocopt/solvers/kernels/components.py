@@ -14,7 +14,7 @@ from __future__ import annotations
 import numpy as np
 from .jit import njit
 
-__all__ = ["split_rows"]
+__all__ = ["split_rows", "local_rows", "labels"]
 
 
 @njit(cache=True, nogil=True)
@@ -24,6 +24,23 @@ def _find(parent, r):
         parent[r] = parent[parent[r]]
         r = parent[r]
     return r
+
+
+@njit(cache=True, nogil=True)
+def labels(parent):
+    """``(n, label)``: the sets of a union-find numbered in the order of their
+    smallest element (the labels scipy's ``connected_components`` gives)."""
+    E = parent.shape[0]
+    first = np.full(E, -1, np.int64)
+    label = np.empty(E, np.int64)
+    n = 0
+    for r in range(E):
+        root = _find(parent, r)
+        if first[root] < 0:
+            first[root] = n
+            n += 1
+        label[r] = first[root]
+    return n, label
 
 
 @njit(cache=True, nogil=True)
@@ -52,15 +69,7 @@ def split_rows(T, off, E):
                 if b < a:
                     a, b = b, a
                 parent[b] = a
-    label = np.full(E, -1, np.int64)
-    of_row = np.empty(E, np.int64)
-    n = 0
-    for r in range(E):
-        root = _find(parent, r)
-        if label[root] < 0:
-            label[root] = n
-            n += 1
-        of_row[r] = label[root]
+    n, of_row = labels(parent)
     of_cand = np.empty(K, np.int64)
     ptr = np.zeros(n + 1, np.int64)
     for k in range(K):

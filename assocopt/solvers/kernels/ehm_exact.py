@@ -28,17 +28,10 @@ from __future__ import annotations
 import numpy as np
 from .jit import njit
 
+from .components import _find, labels
 from .ehm_net import hypothesis_net
 
 __all__ = ["exact_marginals"]
-
-
-@njit(cache=True)
-def _find(parent, a):
-    while parent[a] != a:
-        parent[a] = parent[parent[a]]
-        a = parent[a]
-    return a
 
 
 @njit(cache=True)
@@ -75,15 +68,7 @@ def exact_marginals(E, logw, n, max_nodes):
                     b = _find(parent, r)
                     if a != b:
                         parent[max(a, b)] = min(a, b)
-    label = np.full(n, -1, np.int64)
-    n_comp = 0
-    root_id = np.full(n, -1, np.int64)
-    for r in range(n):
-        root = _find(parent, r)
-        if root_id[root] < 0:
-            root_id[root] = n_comp
-            n_comp += 1
-        label[r] = root_id[root]
+    n_comp, label = labels(parent)
     cand_label = np.empty(K, np.int64)
     for k in range(K):
         cand_label[k] = label[first[k]]
