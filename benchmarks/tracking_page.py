@@ -105,7 +105,8 @@ def targets(data: dict) -> list[str]:
     out.append("- " + worst([k for k in sparse if k[0] == 3 and k[1] >= 200],
                             "N = 3, n >= 200 (target 5x)"))
     out.append("- " + worst([k for k in sparse if k[0] >= 4], "N >= 4 (target 10x)"))
-    out.append("- " + worst([k for k in g if k[0] >= 5], "N >= 5 (target 50x)", "milp"))
+    out.append("- " + worst([k for k in g if k[0] >= 4], "every scan at N >= 4 (target 50x)",
+                            "milp"))
     out.append("- " + worst([k for k in g if k[2] <= DENSE],
                             "one dense component, spacing at or below the gate "
                             "(target 3x)"))
@@ -140,25 +141,26 @@ def readme_figures(data: dict) -> list[str]:
     v4 = [ratio(total(g[k], "highs"), total(g[k], "auto")) for k in g
           if k[2] > DENSE and k[0] >= 4]
     v5 = [v for v in (ratio(total(g[k], "milp"), total(g[k], "auto")) for k in g
-                      if k[0] >= 5) if v is not None]
+                      if k[0] >= 4) if v is not None]
     if v4 and v5:
         out.append(f"N >= 4 at 10x: at least {min(v for v in v4 if v is not None):.1f}x), "
-                   f"50x the plain milp model at N >= 5 on {sum(v >= 50 for v in v5)} of "
+                   f"50x the plain milp model at N >= 4 on {sum(v >= 50 for v in v5)} of "
                    f"the {len(v5)} settings")
     return out
 
 
 #: Why the plain model is level with ``highs`` here (no numbers of this run in it).
 PLAIN_MILP = (
-    "The issue that asked for this benchmark measured its plain `scipy.optimize.milp` "
-    "model 5-14 times slower than `solver=\"highs\"`, and set the N >= 5 target as "
-    "50x the plain model.  Here the plain model (sparse `A`, `mip_rel_gap=0`) runs "
+    "The issues that asked for this benchmark measured their plain "
+    "`scipy.optimize.milp` model 3-14 times slower than `solver=\"highs\"`, and set 50x "
+    "the plain model as a target, first at N >= 5, then for every scan at N >= 4 "
+    "beside 10x against `highs` (on their scans the two asked for about the same).  Here the plain model (sparse `A`, `mip_rel_gap=0`) runs "
     "about as fast as `highs` through our formulation: both hand HiGHS the same "
     "set-partitioning program.  Variants of the plain model that a first attempt "
     "might write (HiGHS's default gap, a dense `A`, presolve off, `A x = 1` as two "
     "inequalities) did not make it slower than `highs` on our N = 4-5 scans either "
-    "(checked by hand; not part of this run).  The issue's generator is not in the "
-    "repository; its scans had many more candidates per target (110k at N = 5, "
+    "(checked by hand; not part of this run).  Their generator is not in the "
+    "repository; their scans had many more candidates per target (110k at N = 5, "
     "n = 50, where ours have a few thousand at spacing 2), which is the likeliest "
     "reason its plain model fell behind.  So on these scans the 50x target against "
     "the plain model is in effect a 50x target against HiGHS itself.")
