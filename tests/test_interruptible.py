@@ -68,3 +68,57 @@ def test_a_kernel_honouring_the_stop_flag_is_awaited():
         assert stop[0] == 1 and done.is_set()
     finally:
         interruptible.INTERRUPTED.clear()
+
+
+def _kernel_threads() -> list[threading.Thread]:
+    return [t for t in threading.enumerate() if t.name == "assocopt-kernel"]
+
+
+def test_worker_threads_are_reused_between_calls():
+    """A call hands its work to an idle worker: a run of calls starts no new threads,
+    and each still gets its own answer (and its own exception)."""
+    interruptible.run_cancellable(int, ("1",), None)
+    before = {t.ident for t in _kernel_threads()}
+    answers = [interruptible.run_cancellable(int, (str(i),), None)[0] for i in range(50)]
+    assert answers == list(range(50))
+    with pytest.raises(ValueError):
+        interruptible.run_cancellable(int, ("x",), None)
+    assert interruptible.run_cancellable(int, ("7",), None) == (7, False)
+    assert {t.ident for t in _kernel_threads()} <= before | {None}
+    assert len(_kernel_threads()) <= interruptible.MAX_IDLE + 1
+
+
+def test_a_busy_worker_is_not_handed_another_call():
+    """While one call runs (a worker left going after Ctrl-C, or another caller's),
+    a second call gets a worker of its own and does not wait for the first."""
+    release = threading.Event()
+    backstop = threading.Timer(DEADLINE, release.set)
+    backstop.start()
+    box = {}
+    first = threading.Thread(
+        target=lambda: box.setdefault("r", interruptible.run_cancellable(
+            release.wait, (DEADLINE,), None)))
+    try:
+        first.start()
+        while not any(t.is_alive() for t in _kernel_threads()):
+            time.sleep(0.01)
+        t0 = time.perf_counter()
+        assert interruptible.run_cancellable(int, ("3",), None) == (3, False)
+        assert time.perf_counter() - t0 < DEADLINE / 2 and not release.is_set()
+    finally:
+        release.set()
+        backstop.cancel()
+        first.join(DEADLINE)
+    assert box["r"] == (True, False)
+
+
+@pytest.mark.skipif(not hasattr(__import__("os"), "fork"), reason="needs os.fork")
+def test_a_forked_child_starts_its_own_workers():
+    """The parent's idle workers do not exist in a forked child (multiprocessing's
+    fork start): the child's call must not be handed to one of them and hang."""
+    import multiprocessing as mp
+    interruptible.run_cancellable(int, ("1",), None)      # an idle worker to inherit
+    ctx = mp.get_context("fork")
+    with ctx.Pool(1) as pool:
+        assert pool.apply_async(interruptible.run_cancellable, (int, ("5",), None)
+                                ).get(DEADLINE) == (5, False)
