@@ -8,6 +8,10 @@ from .jit import njit
 from .relaxation import improve_limit
 
 INF = np.inf
+#: Rows of a bit word, and the most words, of :func:`_dfs_bits`' row sets (int64
+#: words, the sign bit unused, so that they mean the same compiled and as Python).
+WORD = 63
+MAX_WORDS = 2
 
 from .outcomes import BUDGET, COMPLETE  # noqa: E402,F401  (dfs() outcomes)
 
@@ -80,7 +84,22 @@ def dfs(G, c, rp, base, ptr, lst, axis_of, n_axes, int_costs, tol, ub, best_sel,
     bound proven elsewhere (-inf if none); a solution that reaches it ends the search
     at once (the last window of ``lagrangian-exact`` otherwise proved again what the
     smaller windows before it had: Balas-Saltzman n = 22-26, 10-27 ms a window).
+
+    Up to ``WORD * MAX_WORDS`` rows (a tracking scan's components), the search of
+    :func:`_dfs_bits`: the same tree, cheaper nodes.
     """
+    if ptr.shape[0] - 1 <= WORD * MAX_WORDS:
+        return _dfs_bits(G, c, rp, base, ptr, lst, axis_of, n_axes, int_costs, tol, ub,
+                         best_sel, best_len, budget, stop, floor)
+    return _dfs_counts(G, c, rp, base, ptr, lst, axis_of, n_axes, int_costs, tol, ub,
+                       best_sel, best_len, budget, stop, floor)
+
+
+@njit(cache=True, nogil=True)
+def _dfs_counts(G, c, rp, base, ptr, lst, axis_of, n_axes, int_costs, tol, ub, best_sel,
+                best_len, budget, stop, floor):
+    """:func:`dfs` for any number of rows: "is it free" is a count of the chosen
+    candidates that share a row with it, kept up to date by :func:`_mark`."""
     E = ptr.shape[0] - 1
     covered = np.zeros(E, np.bool_)
     blocked = np.zeros(rp.shape[0], np.int32)    # chosen candidates sharing a row
@@ -153,6 +172,144 @@ def dfs(G, c, rp, base, ptr, lst, axis_of, n_axes, int_costs, tol, ub, best_sel,
         if nodes >= budget or stop[0] != 0:
             return BUDGET, ub, best_len, nodes
         e2, bnd = _select(blocked, rp, ptr, lst, axis_of, covered, limit - base - acc, rem)
+        if e2 < 0 or base + acc + bnd >= limit:
+            continue
+        d += 1
+        stack_e[d] = e2
+        stack_p[d] = ptr[e2]
+        stack_k[d] = -1
+    return COMPLETE, ub, best_len, nodes
+
+
+@njit(cache=True)
+def _row_sets(G, E):
+    """Each candidate's rows as bit words (``(K, W)``, row ``e``: bit ``e % WORD`` of
+    word ``e // WORD``) and how many it has."""
+    K, N = G.shape
+    W = (E + WORD - 1) // WORD
+    mask = np.zeros((K, max(W, 1)), np.int64)
+    nrow = np.zeros(K, np.int64)
+    for k in range(K):
+        for s in range(N):
+            e = G[k, s]
+            if e >= 0:
+                mask[k, e // WORD] |= np.int64(1) << np.int64(e % WORD)
+                nrow[k] += 1
+    return mask, nrow
+
+
+@njit(cache=True)
+def _free(mask, cov, k):
+    """Whether none of candidate ``k``'s rows is covered."""
+    for w in range(cov.shape[0]):
+        if mask[k, w] & cov[w]:
+            return False
+    return True
+
+
+@njit(cache=True)
+def _select_bits(mask, cov, rp, ptr, lst, axis_of, slack, rem):
+    """:func:`_select` with "is it free" read from the row sets: ``(row, bound)``."""
+    rem[:] = 0.0
+    best_e = -1
+    best_cnt = 1 << 60
+    for e in range(ptr.shape[0] - 1):
+        if (cov[e // WORD] >> np.int64(e % WORD)) & 1:
+            continue
+        cnt = 0
+        first = 0.0
+        for p in range(ptr[e], ptr[e + 1]):
+            k = lst[p]
+            if rp[k] >= slack:
+                break
+            if _free(mask, cov, k):
+                if cnt == 0:
+                    first = rp[k]
+                cnt += 1
+                if cnt >= best_cnt:
+                    break
+        if cnt == 0:
+            return -1, INF
+        rem[axis_of[e]] += first
+        if cnt < best_cnt:
+            best_cnt = cnt
+            best_e = e
+    return best_e, rem.max()
+
+
+@njit(cache=True, nogil=True)
+def _dfs_bits(G, c, rp, base, ptr, lst, axis_of, n_axes, int_costs, tol, ub, best_sel,
+              best_len, budget, stop, floor):
+    """:func:`dfs` for at most ``WORD * MAX_WORDS`` rows: the covered rows are bit
+    words, so a candidate is free when its row set misses them (one or two ANDs), and
+    choosing or undoing a candidate is an OR or an AND-NOT: no blocked counts to keep
+    (their upkeep was half of a node on the components of a tracking scan).  Visits
+    the same nodes in the same order, so it returns what :func:`dfs` returns."""
+    E = ptr.shape[0] - 1
+    mask, nrow = _row_sets(G, E)
+    cov = np.zeros(mask.shape[1], np.int64)
+    rem = np.zeros(n_axes)
+    stack_e = np.empty(E + 1, np.int64)
+    stack_p = np.empty(E + 1, np.int64)
+    stack_k = np.full(E + 1, -1, np.int64)
+    W = cov.shape[0]
+    limit = improve_limit(ub, int_costs, tol)
+    nodes = 0
+    ncov = 0
+    acc = 0.0
+    e0, bnd = _select_bits(mask, cov, rp, ptr, lst, axis_of, limit - base, rem)
+    if e0 < 0 or base + bnd >= limit:
+        return COMPLETE, ub, best_len, nodes
+    d = 0
+    stack_e[0] = e0
+    stack_p[0] = ptr[e0]
+    stack_k[0] = -1
+    while d >= 0:
+        k = stack_k[d]
+        if k >= 0:                                  # undo the last choice here
+            for w in range(W):
+                cov[w] &= ~mask[k, w]
+            ncov -= nrow[k]
+            acc -= rp[k]
+            stack_k[d] = -1
+        e = stack_e[d]
+        p = stack_p[d]
+        found = -1
+        slack = limit - base - acc
+        while p < ptr[e + 1]:
+            k = lst[p]
+            p += 1
+            if rp[k] >= slack:
+                p = ptr[e + 1]
+                break
+            if _free(mask, cov, k):
+                found = k
+                break
+        stack_p[d] = p
+        if found < 0:
+            d -= 1
+            continue
+        for w in range(W):
+            cov[w] |= mask[found, w]
+        ncov += nrow[found]
+        acc += rp[found]
+        stack_k[d] = found
+        nodes += 1
+        if ncov == E:                               # leaf: an exact cover
+            cost = 0.0
+            for t in range(d + 1):
+                cost += c[stack_k[t]]
+            if cost < limit:
+                ub = cost
+                best_sel[:d + 1] = stack_k[:d + 1]
+                best_len = d + 1
+                limit = improve_limit(ub, int_costs, tol)
+                if limit <= floor:                  # nothing better can exist
+                    return COMPLETE, ub, best_len, nodes
+            continue
+        if nodes >= budget or stop[0] != 0:
+            return BUDGET, ub, best_len, nodes
+        e2, bnd = _select_bits(mask, cov, rp, ptr, lst, axis_of, limit - base - acc, rem)
         if e2 < 0 or base + acc + bnd >= limit:
             continue
         d += 1
