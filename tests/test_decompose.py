@@ -240,6 +240,41 @@ def test_batch_kernel_equals_brute_force(parts):
         assert lb[i] <= ub[i] + 1e-9
 
 
+@settings(max_examples=25)
+@given(st.lists(blocks(3), min_size=2, max_size=6), st.sampled_from(
+    [(0, 10 ** 9), (10 ** 9, 0), (10 ** 9, 10 ** 9), (6, 0), (0, 0)]),
+    st.booleans())
+def test_batch_split_between_threads_gives_the_same_answers(parts, limits, deadline):
+    """The batch runs its small components in the calling thread until its work cap,
+    the rest in a worker thread (and all there under a deadline): wherever that split
+    falls, every component gets the answer it gets alone, written in its own place."""
+    pytest.importorskip("numba")
+    import time
+
+    from assocopt.solvers.bnb import batch as bb
+    Ts, cs, szs, kp = [], [], [], [0]
+    for sizes, T, c in parts:
+        Ts.append(T)
+        cs.append(c)
+        szs.append(sizes)
+        kp.append(kp[-1] + len(T))
+    args = (np.concatenate(Ts), np.concatenate(cs), np.array(kp), np.array(szs))
+    alone = [bb.run_batch(T, c, np.array([0, len(T)]), np.array([sizes]))[0]
+             for sizes, T, c in parts]
+    cand, work = limits
+    saved = bb.INLINE_CANDIDATES, bb.INLINE_WORK
+    bb.INLINE_CANDIDATES, bb.INLINE_WORK = cand, work
+    try:
+        (outcome, ub, lb, chosen), by_clock = bb.run_batch(
+            *args, deadline=time.perf_counter() + 600 if deadline else None)
+    finally:
+        bb.INLINE_CANDIDATES, bb.INLINE_WORK = saved
+    assert not by_clock
+    for i, (o, u, b, ch) in enumerate(alone):
+        assert (outcome[i], ub[i], lb[i]) == (o[0], u[0], b[0])
+        assert chosen[kp[i]:kp[i + 1]].tolist() == ch.tolist()
+
+
 def test_time_limit_is_shared_and_a_stopped_component_stops_the_whole():
     T = np.array([[i, j, k] for i in range(3) for j in range(3) for k in range(3)
                   if (i, j, k) != (0, 0, 0)])

@@ -38,24 +38,24 @@ def _kept(sz):
 
 @njit(cache=True, nogil=True)
 def solve_batch(T, c, kp, sizes, tol, max_iter, probe_every, probe_budget, budget, lam0,
-                patience, lam_min, deflect, recover_every, warm_start, stall_tol, stop):
-    """Solve components ``i`` = candidates ``kp[i]:kp[i+1]`` of ``T`` / ``c`` (local
-    tuples, ``sizes[i]`` their axis sizes).
+                patience, lam_min, deflect, recover_every, warm_start, stall_tol, todo,
+                work_cap, outcome, ub, lb, chosen, stop):
+    """Solve components ``i`` in ``todo`` (in that order), ``i`` = candidates
+    ``kp[i]:kp[i+1]`` of ``T`` / ``c`` (local tuples, ``sizes[i]`` their axis sizes).
 
-    Returns ``(outcome, ub, bound, chosen)``: per component the driver's outcome
-    (``PROVEN``, ``STOPPED``, ``INFEASIBLE``; ``STOPPED`` also for components not
-    reached because ``stop`` was set), its incumbent's cost and its bound; ``chosen``
-    marks the selected candidates (of proven components only).
+    Writes per component the driver's outcome into ``outcome`` (``PROVEN``,
+    ``STOPPED``, ``INFEASIBLE``; left as it is for components not reached), its
+    incumbent's cost into ``ub`` and its bound into ``lb``; ``chosen`` marks the
+    selected candidates (of proven components only).  Returns how many of ``todo``
+    it solved: it stops when ``stop`` is set, and before a component once the work
+    done (candidates x (iterations + nodes), summed) exceeds ``work_cap``.
     """
-    C = kp.shape[0] - 1
     N = T.shape[1]
-    outcome = np.full(C, STOPPED, np.int64)
-    ub = np.full(C, np.inf)
-    lb = np.full(C, -np.inf)
-    chosen = np.zeros(T.shape[0], np.int8)
-    for i in range(C):
-        if stop[0] != 0:
-            break
+    work = 0.0
+    for j in range(todo.shape[0]):
+        if stop[0] != 0 or work > work_cap:
+            return j
+        i = todo[j]
         k0 = kp[i]
         k1 = kp[i + 1]
         Tc = T[k0:k1].copy()
@@ -90,6 +90,7 @@ def solve_batch(T, c, kp, sizes, tol, max_iter, probe_every, probe_budget, budge
         ub[i] = u
         lb[i] = bound
         if out == PROVEN:
-            for j in range(n_sel):
-                chosen[k0 + sel[j]] = 1
-    return outcome, ub, lb, chosen
+            for q in range(n_sel):
+                chosen[k0 + sel[q]] = 1
+        work += (k1 - k0) * (iters + nodes)
+    return todo.shape[0]
