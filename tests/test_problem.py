@@ -4,8 +4,12 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
 
 from assocopt import AssignmentProblem, InvalidProblemError, solve
+
+from conftest import sd_problems
 
 
 def test_dense_square_has_all_tuples_one_based():
@@ -160,3 +164,33 @@ def test_violations_reports_double_cover():
     p = AssignmentProblem.sparse((2, 2), [[1, 1], [2, 1], [2, 2]], [1, 1, 1])
     assert "covered 2 times" in p.violations([0, 1])
     assert p.violations([0, 2]) is None
+
+
+@settings(max_examples=60, deadline=None)
+@given(sd_problems(), st.integers(0, 2 ** 32 - 1), st.booleans())
+def test_violations_agrees_with_counting_each_row(p, seed, shuffle):
+    """``violations`` (whose quick yes takes sorted selections) is None exactly when
+    the selected candidates are distinct and cover every row once, counted here
+    directly; subsets of a solution, a solution plus one, one of it swapped for a
+    candidate with as many real indices (as many entries as rows), random picks."""
+    rng = np.random.default_rng(seed)
+    ref = solve(p, "bruteforce")
+    picks = [rng.choice(p.n_candidates, size=rng.integers(0, p.n_candidates + 1),
+                        replace=bool(rng.integers(2))) for _ in range(5)]
+    if ref.selected is not None:
+        s = ref.selected
+        picks += [s, s[:-1], np.append(s, rng.integers(p.n_candidates)), np.append(s, s[:1])]
+        width = (p.tuples > 0).sum(axis=1)      # swaps that keep the count of indices
+        for j in range(len(s)):
+            for k in np.flatnonzero(width == width[s[j]]):
+                picks.append(np.append(np.delete(s, j), k))
+    for sel in picks:
+        sel = np.asarray(sel, np.int64)
+        sel = rng.permutation(sel) if shuffle else np.sort(sel)
+        count = np.zeros(p.n_rows, np.int64)
+        for k in sel:
+            for axis, i in enumerate(p.tuples[k]):
+                if i > 0:
+                    count[p.row_offsets[axis] + i - 1] += 1
+        exact = len(np.unique(sel)) == len(sel) and bool((count == 1).all())
+        assert (p.violations(sel) is None) == exact
