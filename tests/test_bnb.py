@@ -475,3 +475,32 @@ def test_bit_word_search_visits_the_same_nodes_as_the_counting_one(seed, n, budg
         assert all(a == answers[0] for a in answers[1:])
         assert answers[0][3] > 0
         assert search.dfs(*_search_args(p, seed, ub, budget))[3] == answers[0][3]
+
+
+@pytest.mark.parametrize("seed", range(8))
+def test_greedy_cover_is_an_exact_cover_taken_in_key_order(seed):
+    """``greedy_cover`` (bnb's first incumbent at N >= 4): with every single-index
+    candidate present it always covers; its cover is exact, costs what it says, and
+    each candidate it skipped clashes with one taken before it in key order; without
+    the singles it may fail, and then says so."""
+    from assocopt.solvers.kernels.greedy import greedy_cover
+    p = _scattered(seed, 6, 60)
+    G = kern_relax.prepare(np.ascontiguousarray(p.tuples, np.int64), p.row_offsets,
+                           np.asarray(p.sizes, np.int64), p.costs, 0, 1)[0]
+    key = np.random.default_rng(seed).normal(size=p.n_candidates)
+    sel = np.full(p.n_rows + 1, -1, np.int64)
+    n, cost = greedy_cover(G, p.costs, key, p.n_rows, sel)
+    chosen = sel[:n]
+    assert n > 0 and p.violations(np.sort(chosen)) is None
+    assert cost == pytest.approx(p.costs[chosen].sum())
+    rank = np.argsort(np.argsort(key, kind="stable"), kind="stable")
+    rows = [set(G[k][G[k] >= 0]) for k in range(p.n_candidates)]
+    for k in set(range(p.n_candidates)) - set(chosen.tolist()):
+        if rank[k] < max(rank[chosen]):
+            assert any(rows[k] & rows[j] for j in chosen if rank[j] < rank[k])
+    multi = np.flatnonzero((p.tuples > 0).sum(axis=1) >= 2)   # no singles: a clash
+    q = AssignmentProblem.sparse(p.sizes, p.tuples[multi], p.costs[multi])
+    Gq = kern_relax.prepare(np.ascontiguousarray(q.tuples, np.int64), q.row_offsets,
+                            np.asarray(q.sizes, np.int64), q.costs, 0, 1)[0]
+    n, cost = greedy_cover(Gq, q.costs, q.costs, q.n_rows, sel)
+    assert (n == -1 and cost == np.inf) or q.violations(np.sort(sel[:n])) is None

@@ -1,11 +1,13 @@
-"""The ``bnb`` driver: subgradient ascent with N = 3 primal recovery and periodic
-searches (:func:`.search.dfs`), then the final search; one compiled call per problem."""
+"""The ``bnb`` driver: subgradient ascent with N = 3 primal recovery (at N >= 4 a
+greedy cover, :mod:`.greedy`, as the first incumbent) and periodic searches
+(:func:`.search.dfs`), then the final search; one compiled call per problem."""
 
 from __future__ import annotations
 
 import numpy as np
 from .jit import njit
 
+from .greedy import greedy_cover
 from .hungarian import hungarian
 from .recovery import recover3_sparse
 from .relaxation import (evaluate, full_reduced, improve_limit, raise_rows, reduced,
@@ -194,6 +196,13 @@ def solve(G, pa, pb, c, relaxed, a, b, off_a, off_b, na, nb, plain, axis_of, ptr
                 ub = cost
                 best_sel[:m] = tmp_sel[:m]
                 best_len = m
+        if it == 1 and ub == INF:         # no recovery: a greedy cover to start from
+            for key in (c,):
+                m, cost = greedy_cover(G, c, key, E, tmp_sel)
+                if m > 0 and cost < ub:
+                    ub = cost
+                    best_sel[:m] = tmp_sel[:m]
+                    best_len = m
         if best_L >= improve_limit(ub, int_costs, tol):
             return PROVEN, best_sel, best_len, ub, best_L, it, nodes
         if probe_every > 0 and (it - 1) % probe_every == 0:
