@@ -206,6 +206,8 @@ def test_bnb_cap_follows_the_route(monkeypatch):
     monkeypatch.setattr(tiers, "_MODE", ["compiled"])
     assert choice.bnb_cap(np.array([True, False])).tolist() == \
         [choice.BNB_MAX_GATED_COMPILED, choice.BNB_MAX_CANDIDATES]
+    assert choice.bnb_cap(np.array([True, False]), 5).tolist() == \
+        [choice.BNB_MAX_GATED_WIDE, choice.BNB_MAX_CANDIDATES]
     monkeypatch.setattr(tiers, "_MODE", ["interpreted"])
     assert choice.bnb_cap(np.array([True, False])).tolist() == \
         [choice.BNB_MAX_GATED, choice.BNB_MAX_CANDIDATES]

@@ -11,7 +11,7 @@ from ..problems.problem import AssignmentProblem
 from ..solvers.base import module_installed
 
 __all__ = ["choose_solver", "bnb_cap", "BNB_MAX_CANDIDATES", "BNB_MAX_GATED",
-           "BNB_MAX_GATED_COMPILED", "BNB_MAX_KEPT", "BNB_MAX_GRID"]
+           "BNB_MAX_GATED_COMPILED", "BNB_MAX_GATED_WIDE", "BNB_MAX_KEPT", "BNB_MAX_GRID"]
 
 
 #: ``auto`` sends N >= 3 problems with at most this many candidates to ``bnb``
@@ -51,6 +51,14 @@ BNB_MAX_GATED = 2_000
 #: caps of 400 and 500 were level with 700 or slower (the batch has no per-component
 #: overhead), so it stays.
 BNB_MAX_GATED_COMPILED = 700
+#: ... raised to this many at N >= 5 once ``bnb`` started its search from a greedy
+#: cover (:mod:`assocopt.solvers.kernels.greedy`): on the scans of seeds 51-52 at
+#: N = 5-6 a cap of 1,500 was 12 % quicker than 700 (geometric mean of the five N >= 5
+#: settings), 2,000 and 3,000 level with it; at N = 4 (spacing 1.5) it was slower.  On
+#: the 1,000-1,500-candidate multi-frame components of benchmarks/mfa_components.py
+#: (N = 5-7, up to 20 indices an axis) it was about level: 10.7 ms against 9.3 on the
+#: five (three quicker, two slower), all still 11-60x ahead of HiGHS.
+BNB_MAX_GATED_WIDE = 1_500
 
 
 def choose_solver(problem: AssignmentProblem, relax: str | None = None) -> str:
@@ -64,7 +72,8 @@ def choose_solver(problem: AssignmentProblem, relax: str | None = None) -> str:
     if problem.ndim == 2:
         return "scipy-lsa"
     gated = problem.n_candidates > 0 and int(problem.tuples.min()) == 0   # a dummy index
-    cap = bnb_cap(gated) if gated or not _square_grid(problem) else BNB_MAX_GRID
+    cap = bnb_cap(gated, problem.ndim) if gated or not _square_grid(problem) \
+        else BNB_MAX_GRID
     if problem.n_candidates <= cap and _bnb_usable(problem):
         return "bnb"
     return "lagrangian-exact"
@@ -76,13 +85,14 @@ def _square_grid(problem: AssignmentProblem) -> bool:
     return len(s) == 3 and s[0] == s[1] == s[2] and problem.n_candidates == s[0] ** 3
 
 
-def bnb_cap(gated):
+def bnb_cap(gated, ndim: int = 3):
     """The most candidates ``auto`` gives ``bnb``: :data:`BNB_MAX_GATED` for a problem
     (or, elementwise, component) with dummies (at most :data:`BNB_MAX_GATED_COMPILED`
-    where the gated relaxation runs compiled), else :data:`BNB_MAX_CANDIDATES`."""
+    where the gated relaxation runs compiled, :data:`BNB_MAX_GATED_WIDE` there at
+    ``ndim`` >= 5), else :data:`BNB_MAX_CANDIDATES`."""
     cap = BNB_MAX_GATED
     if np.any(gated) and _sparse_relaxation_compiled(cap):
-        cap = min(cap, BNB_MAX_GATED_COMPILED)
+        cap = min(cap, BNB_MAX_GATED_WIDE if ndim >= 5 else BNB_MAX_GATED_COMPILED)
     return np.where(gated, cap, BNB_MAX_CANDIDATES)
 
 

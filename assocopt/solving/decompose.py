@@ -204,7 +204,8 @@ def _solve_parts(problem: AssignmentProblem, sp: Split, todo: np.ndarray,
             # cost 0.4 ms on a 22,000-candidate N = 6 scan)
             dummy = real_counts(T) < T.shape[1]
             gated = np.bincount(sp.of_cand[dummy], minlength=sp.n)[todo] > 0
-            fits = (sp.sizes[todo] <= bnb_cap(gated)) & (top2.sum(axis=1) <= BNB_MAX_KEPT)
+            fits = (sp.sizes[todo] <= bnb_cap(gated, problem.ndim)) & \
+                (top2.sum(axis=1) <= BNB_MAX_KEPT)
         from ..solvers.bnb.batch import solve_components
         left = _left(opts, t0)()
         # bnb's own options only when bnb was asked for: with plain ``auto`` ``opts``
