@@ -56,8 +56,9 @@ BNB_MAX_GATED_COMPILED = 700
 #: N = 5-6 a cap of 1,500 was 12 % quicker than 700 (geometric mean of the five N >= 5
 #: settings), 2,000 and 3,000 level with it; at N = 4 (spacing 1.5) it was slower.  On
 #: the 1,000-1,500-candidate multi-frame components of benchmarks/mfa_components.py
-#: (N = 5-7, up to 20 indices an axis) it was about level: 10.7 ms against 9.3 on the
-#: five (three quicker, two slower), all still 11-60x ahead of HiGHS.
+#: (N = 5-7, up to 20 indices an axis) it is slower: 13.0 ms against 9.3 on the five
+#: in the runs of docs/benchmarks-mfa-components.md before and after (the widest, 19-20 an
+#: axis: 5.1 against 2.4 ms), still 5-58x ahead of HiGHS there.
 BNB_MAX_GATED_WIDE = 1_500
 
 
