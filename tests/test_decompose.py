@@ -212,20 +212,23 @@ def test_infeasible_component_makes_whole_infeasible():
         assert a.status is b.status
 
 
+def _batch_of(parts: list) -> tuple[np.ndarray, ...]:
+    """``(T, c, kp, sizes)`` of the batch kernel: the parts one after the other."""
+    kp = np.cumsum([0] + [len(T) for _, T, _ in parts])
+    return (np.concatenate([T for _, T, _ in parts]),
+            np.concatenate([c for _, _, c in parts]), kp,
+            np.array([sizes for sizes, _, _ in parts]))
+
+
 @settings(max_examples=40)
 @given(st.lists(blocks(3), min_size=1, max_size=5))
 def test_batch_kernel_equals_brute_force(parts):
     pytest.importorskip("numba")
     from assocopt.solvers.bnb.batch import run_batch
     from assocopt.solvers.kernels.driver import INFEASIBLE, PROVEN
-    Ts, cs, szs, kp = [], [], [], [0]
-    for sizes, T, c in parts:
-        Ts.append(T)
-        cs.append(c)
-        szs.append(sizes)
-        kp.append(kp[-1] + len(T))
-    (outcome, ub, lb, chosen), _ = run_batch(np.concatenate(Ts), np.concatenate(cs),
-                                             np.array(kp), np.array(szs))
+    batch = _batch_of(parts)
+    kp = batch[2]
+    (outcome, ub, lb, chosen), _ = run_batch(*batch)
     for i, (sizes, T, c) in enumerate(parts):
         ref = solve(AssignmentProblem.sparse(sizes, T, c), "bruteforce")
         if ref.status is Status.INFEASIBLE:
@@ -252,13 +255,8 @@ def test_batch_split_between_threads_gives_the_same_answers(parts, limits, deadl
     import time
 
     from assocopt.solvers.bnb import batch as bb
-    Ts, cs, szs, kp = [], [], [], [0]
-    for sizes, T, c in parts:
-        Ts.append(T)
-        cs.append(c)
-        szs.append(sizes)
-        kp.append(kp[-1] + len(T))
-    args = (np.concatenate(Ts), np.concatenate(cs), np.array(kp), np.array(szs))
+    args = _batch_of(parts)
+    kp = args[2]
     alone = [bb.run_batch(T, c, np.array([0, len(T)]), np.array([sizes]))[0]
              for sizes, T, c in parts]
     cand, work = limits

@@ -197,12 +197,11 @@ def solve(G, pa, pb, c, relaxed, a, b, off_a, off_b, na, nb, plain, axis_of, ptr
                 best_sel[:m] = tmp_sel[:m]
                 best_len = m
         if it == 1 and ub == INF:         # no recovery: a greedy cover to start from
-            for key in (c,):
-                m, cost = greedy_cover(G, c, key, E, tmp_sel)
-                if m > 0 and cost < ub:
-                    ub = cost
-                    best_sel[:m] = tmp_sel[:m]
-                    best_len = m
+            m, cost = greedy_cover(G, c, c, E, tmp_sel)
+            if m > 0:
+                ub = cost
+                best_sel[:m] = tmp_sel[:m]
+                best_len = m
         if best_L >= improve_limit(ub, int_costs, tol):
             return PROVEN, best_sel, best_len, ub, best_L, it, nodes
         if probe_every > 0 and (it - 1) % probe_every == 0:
