@@ -288,7 +288,8 @@ def measure(keys: list[str]) -> dict[str, Any]:
                         "machine": platform.machine(), "cpus": os.cpu_count()},
             "versions": _versions(), "load_before": load_before, "load_after": _load(),
             "rule": {"budget_cold_s": tiers.BUDGET_COLD,
-                     "budget_cached_s": tiers.BUDGET_CACHED, "limits": dict(tiers.LIMITS)},
+                     "budget_cached_s": tiers.BUDGET_CACHED,
+                     "budget_warm_s": tiers.BUDGET_WARM, "limits": dict(tiers.LIMITS)},
             "rows": rows, "together": together}
 
 

@@ -35,6 +35,7 @@ def test_first_use_measurements_cover_every_timed_path(bench):
                                "warm_s": bench.WARM_TARGET}
     assert data["rule"] == {"budget_cold_s": tiers.BUDGET_COLD,
                             "budget_cached_s": tiers.BUDGET_CACHED,
+                            "budget_warm_s": tiers.BUDGET_WARM,
                             "limits": tiers.LIMITS}
     assert len(data["load_before"]) == len(data["load_after"]) == 3
 

@@ -21,6 +21,7 @@ KEYS = [key for key, _what, _fn in first_use.PATHS]
 def fresh(monkeypatch):
     """A process state without interpreted seconds and with the default rule."""
     monkeypatch.setattr(tiers, "_SPENT", {})
+    monkeypatch.setattr(tiers, "_WARM", [False])
     monkeypatch.delenv("ASSOCOPT_JIT", raising=False)
     tiers.set_mode(None)
     yield
@@ -64,6 +65,28 @@ def test_the_budget_closes_the_interpreted_route(fresh, monkeypatch):
     tiers.exhaust("x.y")
     assert not tiers.interpret("x.y", 1, lambda: False)
     assert tiers.budget_left("x.y") == 0.0
+
+
+def test_a_warm_process_loads_a_cached_kernel_sooner(fresh, monkeypatch):
+    """Once the process holds machine code of some kernel, a cached kernel is loaded
+    after the small warm budget; a kernel that must be compiled keeps the cold one."""
+    monkeypatch.setattr(tiers, "LIMITS", {"x.y": 100})
+    tiers._SPENT["x.y"] = tiers.BUDGET_WARM + 0.001
+    assert tiers.interpret("x.y", 1, lambda: True)           # nothing loaded yet
+    tiers.warmed()
+    assert not tiers.interpret("x.y", 1, lambda: True)       # cached: load it now
+    assert tiers.interpret("x.y", 1, lambda: False)          # cold: still interpreted
+    tiers._SPENT["x.y"] = tiers.BUDGET_WARM / 2
+    assert tiers.interpret("x.y", 1, lambda: True)
+
+
+def test_loading_a_kernel_marks_the_process_warm(fresh):
+    """:func:`kernels.ensure` records the load (or compile) it times."""
+    p = random_problem(np.random.default_rng(3), "sd", sizes=(4, 4, 3), keep=0.5)
+    tiers.set_mode("compiled")
+    kernels._SEEN.clear()
+    solve(p, "bnb")
+    assert tiers._WARM[0]
 
 
 def test_interpreted_time_is_counted(fresh):

@@ -120,8 +120,10 @@ def ensure(kernel: Any, *args: Any) -> None:
         sig = tuple(kernel.typeof_pyval(a) for a in args)
     except Exception:          # not a numba dispatcher: nothing to prepare
         return
+    from . import tiers
     if sig in kernel.overloads:
         _SEEN.add(key)
+        tiers.warmed()
         return
     if not _ANNOUNCED[0] and not _on_disk(kernel, sig):
         _ANNOUNCED[0] = True
@@ -134,6 +136,7 @@ def ensure(kernel: Any, *args: Any) -> None:
     dt = time.perf_counter() - t0
     _SPENT["cache_load" if sum(kernel.stats.cache_hits.values()) > hits else "compile"] += dt
     _SEEN.add(key)
+    tiers.warmed()
 
 
 def pick(kernel: Any, *args: Any, work: float) -> Any:

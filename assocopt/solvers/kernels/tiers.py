@@ -13,7 +13,9 @@ plain Python, numba not involved: :func:`plain`) while
   function answers within about a tenth of a second), and
 * the interpreted calls of this kernel have cost less than the budget so far:
   :data:`BUDGET_COLD` seconds when the kernel would have to be compiled,
-  :data:`BUDGET_CACHED` when numba's disk cache holds it (loading is cheaper);
+  :data:`BUDGET_CACHED` when numba's disk cache holds it (loading is cheaper), and
+  :data:`BUDGET_WARM` when the disk cache holds it and this process has loaded or
+  compiled a kernel already (numba and LLVM are up: a load costs milliseconds);
 
 otherwise it is compiled (or loaded) and runs compiled from then on.  That is the
 ski-rental rule: a process that keeps calling pays at most its budget before it
@@ -43,8 +45,8 @@ import time
 import types
 from typing import Any, Callable, Iterator
 
-__all__ = ["MODES", "LIMITS", "BUDGET_COLD", "BUDGET_CACHED", "mode", "set_mode",
-           "interpret", "plain", "compiled", "interpreted_seconds", "exhaust", "charge",
+__all__ = ["MODES", "LIMITS", "BUDGET_COLD", "BUDGET_CACHED", "BUDGET_WARM", "mode",
+           "set_mode", "warmed", "interpret", "plain", "compiled", "interpreted_seconds", "exhaust", "charge",
            "reproducible"]
 
 MODES = ("auto", "compiled", "interpreted")
@@ -53,6 +55,11 @@ MODES = ("auto", "compiled", "interpreted")
 #: when numba would compile it (cold) and when its disk cache holds it (cached).
 BUDGET_COLD = 2.0
 BUDGET_CACHED = 0.3
+#: The cached budget once this process holds machine code of some kernel: loading one
+#: more from the disk cache then took 3-40 ms (the first load of a process 160 ms, most
+#: of it numba's code generator starting), so a kernel whose numpy or plain route
+#: stands in at 0.5 ms a call is loaded after about 60 calls, not 600.
+BUDGET_WARM = 0.03
 
 #: Largest ``work`` of an interpreted call, per kernel (``module.function``); the unit
 #: is the one its call site passes.  Set where the plain function takes about a second
@@ -90,6 +97,8 @@ LIMITS: dict[str, float] = {
 }
 
 _MODE: list[str | None] = [None]
+#: Whether this process has compiled or loaded a kernel (:func:`warmed`).
+_WARM = [False]
 _SPENT: dict[str, float] = {}
 _LOCK = threading.Lock()
 _HOME = __name__.rsplit(".", 1)[0]
@@ -148,6 +157,12 @@ def compiled(name: str) -> Any:
     return getattr(importlib.import_module(f"{_HOME}.{module}"), func)
 
 
+def warmed() -> None:
+    """Record that this process holds machine code of a kernel (called by
+    :func:`assocopt.solvers.kernels.ensure` after a compile or a load)."""
+    _WARM[0] = True
+
+
 def interpret(name: str, work: float, cached: Callable[[], bool]) -> bool:
     """Whether a call of kernel ``name`` with ``work`` runs interpreted (module doc);
     ``cached()`` tells whether numba's disk cache holds it (asked only if it matters)."""
@@ -159,7 +174,10 @@ def interpret(name: str, work: float, cached: Callable[[], bool]) -> bool:
     if work > LIMITS.get(name, -1.0):
         return False
     spent = _SPENT.get(name, 0.0)
-    return spent < BUDGET_COLD and (spent < BUDGET_CACHED or not cached())
+    if spent < BUDGET_WARM:
+        return True
+    return spent < BUDGET_COLD and ((spent < BUDGET_CACHED and not _WARM[0])
+                                    or not cached())
 
 
 def budget_left(name: str) -> float:
