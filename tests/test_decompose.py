@@ -155,6 +155,42 @@ def test_split_kernel_equals_numpy_route(p):
         assert np.array_equal(T, T2) and np.array_equal(sizes, sizes2)
 
 
+@settings(max_examples=30, deadline=None)
+@given(side_by_side())
+def test_scan_split_and_gather_kernels_equal_numpy_routes(p):
+    """``split(..., scan=True)`` and :func:`gather`: the kernels (compiled, and as
+    plain twins) give the numpy routes' arrays; the local indices and axis sizes are
+    those of :func:`local_tuples`, the dummy flags those of the tuples."""
+    pytest.importorskip("numba")
+    from assocopt.problems.components import component_tuples, gather
+    from assocopt.solvers.kernels import tiers
+    from assocopt.solvers.kernels.components import gather_parts, scan_parts
+    want = split(p, scan=True)
+    axis = np.repeat(np.arange(p.ndim), p.sizes).astype(np.int64)
+    fields = ("n", "of_row", "of_cand", "order", "ptr", "trivial", "local", "csizes",
+              "gated")
+    for fn in (scan_parts, tiers.plain("components.scan_parts")):
+        got = fn(p.tuples, p.row_offsets, p.n_rows, axis)
+        for name, a in zip(fields, got):
+            assert np.array_equal(a, getattr(want, name)), name
+    T, sizes = local_tuples(p, want.of_row, want.n)
+    assert np.array_equal(want.csizes, sizes)
+    assert np.array_equal(component_tuples(p, want, np.arange(p.n_candidates)), T)
+    has_dummy = (p.tuples == 0).any(axis=1)
+    assert np.array_equal(want.gated, [has_dummy[want.of_cand == c].any()
+                                       for c in range(want.n)])
+    comps = np.arange(want.n, dtype=np.int64)[::-2].copy()      # any order, a subset
+    Tb, cb, kp = gather(p, want, comps)
+    cand = np.concatenate([want.order[want.ptr[c]:want.ptr[c + 1]] for c in comps]
+                          + [np.zeros(0, np.int64)])
+    assert np.array_equal(Tb, T[cand]) and np.array_equal(cb, p.costs[cand])
+    assert np.array_equal(np.diff(kp), want.sizes[comps])
+    args = (p.tuples, p.costs, p.row_offsets, want.local, want.order, want.ptr, comps)
+    for fn in (gather_parts, tiers.plain("components.gather_parts")):
+        for a, b in zip(fn(*args), (Tb, cb, kp)):
+            assert np.array_equal(a, b)
+
+
 def test_split_routes_by_the_tier_rule(monkeypatch):
     """``split(p, routed)``: the numpy route (charged to the kernel's budget) while
     interpreted, the kernel once compiled; the same split either way."""

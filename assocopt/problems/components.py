@@ -20,7 +20,8 @@ import numpy as np
 
 from .problem import AssignmentProblem
 
-__all__ = ["Split", "split", "split_rows", "local_tuples", "subproblem"]
+__all__ = ["Split", "split", "split_rows", "local_tuples", "subproblem", "gather",
+           "component_tuples"]
 
 
 @dataclass(frozen=True)
@@ -39,6 +40,12 @@ class Split:
     order: np.ndarray
     ptr: np.ndarray
     trivial: np.ndarray
+    #: with ``split(..., scan=True)``: each row's index within its component and axis
+    #: (E,), ``1..``; the components' axis sizes (n, N); whether a component holds a
+    #: tuple with a dummy (n,)
+    local: np.ndarray | None = None
+    csizes: np.ndarray | None = None
+    gated: np.ndarray | None = None
 
     @property
     def sizes(self) -> np.ndarray:
@@ -46,13 +53,23 @@ class Split:
         return np.diff(self.ptr)
 
 
-def split(problem: AssignmentProblem, run: Callable | None = None) -> Split:
+def split(problem: AssignmentProblem, run: Callable | None = None,
+          scan: bool = False) -> Split:
     """The connected components of ``problem`` (every real index covered).
 
     ``run``: :func:`assocopt.solvers.kernels.routed` (the solvers pass it), which runs
     the compiled kernel :func:`assocopt.solvers.kernels.components.split_rows` where
-    that costs less, else the numpy route below (same answer)."""
+    that costs less, else the numpy route below (same answer).  ``scan``: also the
+    local row indices, axis sizes and dummy flags of the components (the kernel
+    ``scan_parts``), which :func:`gather` and :func:`component_tuples` read."""
     E = problem.n_rows
+    if scan:
+        axis = np.repeat(np.arange(problem.ndim, dtype=np.int64), problem.sizes)
+        fallback = lambda T, off, E, axis: _scan_parts(problem, E, axis)  # noqa: E731
+        if run is None:
+            return Split(*fallback(None, None, E, axis))
+        return Split(*run("components.scan_parts", fallback, problem.tuples,
+                          problem.row_offsets, E, axis, work=problem.n_candidates))
     if run is None:
         return Split(*split_rows(problem.entry_rows, E))
     # the kernel reads the tuples (no entry-row array built); numpy reads the rows
@@ -87,6 +104,51 @@ def split_rows(R: np.ndarray, E: int) -> tuple:
     return n, of_row, of_cand, order, ptr, trivial
 
 
+def _scan_parts(problem: AssignmentProblem, E: int, axis_of_row: np.ndarray) -> tuple:
+    """The kernel ``scan_parts`` in numpy."""
+    from .indexing import real_counts
+    N = problem.ndim
+    n, of_row, of_cand, order, ptr, trivial = split_rows(problem.entry_rows, E)
+    key = of_row * N + axis_of_row
+    srt = np.argsort(key, kind="stable")
+    counts = np.bincount(key, minlength=n * N)
+    start = np.concatenate([[0], np.cumsum(counts)[:-1]])
+    local = np.empty(E, np.int64)
+    local[srt] = np.arange(E) - start[key[srt]] + 1
+    gated = np.bincount(of_cand[real_counts(problem.tuples) < N], minlength=n) > 0
+    return n, of_row, of_cand, order, ptr, trivial, local, counts.reshape(n, N), gated
+
+
+def component_tuples(problem: AssignmentProblem, sp: Split, cand: np.ndarray
+                     ) -> np.ndarray:
+    """The tuples of candidates ``cand`` relabelled within their components (a split
+    with ``scan=True``), ``(len(cand), N)``."""
+    R = problem.entry_rows[cand]
+    return np.where(R >= 0, sp.local[np.maximum(R, 0)], 0)
+
+
+def gather(problem: AssignmentProblem, sp: Split, comps: np.ndarray,
+           run: Callable | None = None) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """``(T, c, kp)`` of the batch kernel for components ``comps`` of ``sp`` (split
+    with ``scan=True``): their candidates one component after the other, in
+    ``sp.order``, tuples relabelled within their components, ``kp`` where each
+    starts.  ``run``: as for :func:`split` (the kernel ``gather_parts``)."""
+    comps = np.ascontiguousarray(comps, np.int64)
+
+    def numpy_route(T0, costs, off, local, order, ptr, comps):
+        counts = ptr[comps + 1] - ptr[comps]
+        kp = np.zeros(len(comps) + 1, np.int64)
+        np.cumsum(counts, out=kp[1:])
+        cand = order[np.repeat(ptr[comps] - kp[:-1], counts) + np.arange(kp[-1])]
+        return component_tuples(problem, sp, cand), costs[cand], kp
+    args = (problem.tuples, problem.costs, problem.row_offsets, sp.local, sp.order,
+            sp.ptr, comps)
+    if run is None:
+        return numpy_route(*args)
+    return run("components.gather_parts", numpy_route, *args,
+               work=int((sp.ptr[comps + 1] - sp.ptr[comps]).sum()))
+
+
 def local_tuples(problem: AssignmentProblem, part_of_row: np.ndarray, n_parts: int,
                  run: Callable | None = None) -> tuple[np.ndarray, np.ndarray]:
     """Each candidate's tuple relabelled within its part (parts: groups of whole
@@ -119,8 +181,10 @@ def _local_rows(R: np.ndarray, part_of_row: np.ndarray, n_parts: int,
 
 
 def subproblem(problem: AssignmentProblem, T: np.ndarray, sizes: np.ndarray,
-                cand: np.ndarray) -> AssignmentProblem:
-    """The problem of candidates ``cand`` (tuples already relabelled in ``T``)."""
-    return AssignmentProblem._build(tuple(int(v) for v in sizes), T[cand],
+               cand: np.ndarray, gathered: bool = False) -> AssignmentProblem:
+    """The problem of candidates ``cand`` (tuples already relabelled in ``T``: all
+    candidates' rows, or with ``gathered`` those of ``cand`` only)."""
+    return AssignmentProblem._build(tuple(int(v) for v in sizes),
+                                    T if gathered else T[cand],
                                     problem.costs[cand], problem.slack[cand],
                                     kind="sparse")

@@ -31,9 +31,9 @@ from typing import Any
 
 import numpy as np
 
-from ..problems.components import Split, local_tuples, split, subproblem as _subproblem
+from ..problems.components import (Split, component_tuples, local_tuples, split,
+                                   subproblem as _subproblem)
 from ..solvers.kernels import routed
-from ..problems.indexing import real_counts
 from ..problems.problem import AssignmentProblem
 from ..model.solution import Status
 from ..solvers.base import RawResult, SolveOptions, get_backend
@@ -144,7 +144,7 @@ def solve_decomposed(problem: AssignmentProblem, requested: str, name: str,
     if decompose is None and (problem.n_candidates < MIN_CANDIDATES or _full_grid(problem)):
         return None
     t0 = time.perf_counter()
-    sp = split(problem, routed)
+    sp = split(problem, routed, scan=True)
     if sp.n == 1 and not sp.trivial[0]:        # one component: the whole problem
         if requested == "auto":
             opts = _auto_options(problem, name, opts)
@@ -189,7 +189,7 @@ def _solve_parts(problem: AssignmentProblem, sp: Split, todo: np.ndarray,
     kernel settled."""
     from .choice import BNB_MAX_KEPT, _numba_installed, bnb_cap
 
-    T, csizes = local_tuples(problem, sp.of_row, sp.n, routed)
+    csizes = sp.csizes
     plain_auto = requested == "auto"
     single, grouped, n_batched = todo, todo[:0], 0
     batch = (plain_auto or name == "bnb") and _numba_installed()
@@ -200,10 +200,7 @@ def _solve_parts(problem: AssignmentProblem, sp: Split, todo: np.ndarray,
             fits = (top2.sum(axis=1) <= MAX_KEPT) & \
                 ((top2[:, 0] + 1) * (top2[:, 1] + 1) <= MAX_DENSE)
         else:
-            # a dummy in some tuple, counted column by column (``(T == 0).any(axis=1)``
-            # cost 0.4 ms on a 22,000-candidate N = 6 scan)
-            dummy = real_counts(T) < T.shape[1]
-            gated = np.bincount(sp.of_cand[dummy], minlength=sp.n)[todo] > 0
+            gated = sp.gated[todo]
             fits = (sp.sizes[todo] <= bnb_cap(gated, problem.ndim)) & \
                 (top2.sum(axis=1) <= BNB_MAX_KEPT)
         from ..solvers.bnb.batch import solve_components
@@ -211,14 +208,16 @@ def _solve_parts(problem: AssignmentProblem, sp: Split, todo: np.ndarray,
         # bnb's own options only when bnb was asked for: with plain ``auto`` ``opts``
         # holds the whole problem's choice's (lagrangian-exact's max_iter, step0, ...)
         bnb_opts = opts if name == "bnb" else _defaults(opts)
-        redo = solve_components(problem, T, csizes, sp, todo[fits], bnb_opts, left, out)
+        redo = solve_components(problem, sp, todo[fits], bnb_opts, left, out)
         n_batched = int(fits.sum()) - len(redo)
         single = np.concatenate([redo, todo[~fits]]).astype(np.int64)
     elif name in GROUPED:
         small = sp.sizes[todo] <= GROUP_MAX
         single, grouped = todo[~small], todo[small]
     jobs = [(csizes[c], sp.order[sp.ptr[c]:sp.ptr[c + 1]], 1) for c in single]
+    T = None
     if len(grouped):
+        T, _ = local_tuples(problem, sp.of_row, sp.n, routed)
         jobs.append(_group(T, csizes, sp, grouped))
     for sizes, cand, count in jobs:
         remaining = _left(opts, t0)()
@@ -226,7 +225,9 @@ def _solve_parts(problem: AssignmentProblem, sp: Split, todo: np.ndarray,
             out.add(Status.TIME_LIMIT, None, None, name, count,
                     "time limit reached before this component")
             continue
-        sub = _subproblem(problem, T, sizes, cand)
+        sub = _subproblem(problem, T, sizes, cand) if T is not None else \
+            _subproblem(problem, component_tuples(problem, sp, cand), sizes, cand,
+                        gathered=True)
         # with the batch: what it left is past bnb's caps (choose_solver would say
         # lagrangian-exact) or spent bnb's node budget
         solver = ("lagrangian-exact" if batch else _auto_choice(sub)) if plain_auto \

@@ -24,22 +24,12 @@ from ..interruptible import new_stop
 from ..kernels.outcomes import STOPPED
 from .kernels import run_tiered
 
-__all__ = ["solve_components", "batch_arrays", "run_batch", "INLINE_WORK"]
+__all__ = ["solve_components", "run_batch", "INLINE_WORK"]
 
 #: Work (candidates x (ascent iterations + search nodes), summed over components) that
 #: a batch does in the calling thread before the rest goes to a worker thread: about
 #: 10-20 ms (a gated scan's component of 300 candidates: 1 iteration, 100 nodes, 30k).
 INLINE_WORK = 10_000_000
-
-
-def batch_arrays(T: np.ndarray, costs: np.ndarray, parts: list[np.ndarray]
-                 ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """``(T, c, kp)`` of the kernel: the candidates of each part (positions into
-    ``T`` / ``costs``) one after the other, ``kp`` where each part starts."""
-    kp = np.zeros(len(parts) + 1, np.int64)
-    np.cumsum([len(p) for p in parts], out=kp[1:])
-    cand = np.concatenate(parts) if parts else np.zeros(0, np.int64)
-    return np.ascontiguousarray(T[cand]), np.ascontiguousarray(costs[cand]), kp
 
 
 def run_batch(T: np.ndarray, c: np.ndarray, kp: np.ndarray, sizes: np.ndarray,
@@ -84,31 +74,31 @@ def run_batch(T: np.ndarray, c: np.ndarray, kp: np.ndarray, sizes: np.ndarray,
     return answer, by_clock
 
 
-def solve_components(problem: Any, T: np.ndarray, csizes: np.ndarray, sp: Any,
-                     comps: np.ndarray, opts: SolveOptions, left: float | None,
-                     out: Any) -> np.ndarray:
-    """Solve components ``comps`` of the split ``sp`` in one kernel call, adding
-    their answers to ``out`` (:class:`assocopt.solving.decompose._Outcome`); returns the
-    components whose node budget ran out, for the caller to solve alone."""
+def solve_components(problem: Any, sp: Any, comps: np.ndarray, opts: SolveOptions,
+                     left: float | None, out: Any) -> np.ndarray:
+    """Solve components ``comps`` of the split ``sp`` (``split(..., scan=True)``) in
+    one kernel call, adding their answers to ``out``
+    (:class:`assocopt.solving.decompose._Outcome`); returns the components whose node
+    budget ran out, for the caller to solve alone."""
     import time
+    from ...problems.components import gather
+    from ..kernels import routed
     if len(comps) == 0:
         return comps
-    parts = [sp.order[sp.ptr[c]:sp.ptr[c + 1]] for c in comps]
-    Tb, cb, kp = batch_arrays(T, problem.costs, parts)
+    Tb, cb, kp = gather(problem, sp, comps, routed)
     params = {k: v for k, v in opts.extra.items() if k in DEFAULTS} \
         if opts.parsed else {}
     params.pop("keep_axes", None)
     params.pop("fallback", None)
     deadline = None if left is None else time.perf_counter() + max(left, 0.0)
-    (outcome, ub, lb, chosen), by_clock = run_batch(Tb, cb, kp, csizes[comps], params,
+    (outcome, ub, lb, chosen), by_clock = run_batch(Tb, cb, kp, sp.csizes[comps], params,
                                                     deadline)
     from ..kernels.outcomes import INFEASIBLE, PROVEN
     proven = outcome == PROVEN
     found = np.isfinite(ub)
-    cand = np.concatenate(parts)
     ok = proven & found
     if ok.any():
-        sel = cand[chosen.astype(bool)]
+        sel = _candidates(sp, comps, kp, np.flatnonzero(chosen))
         out.add(Status.OPTIMAL, sel, float(ub[ok].sum()), "bnb", int(ok.sum()))
     bad = (outcome == INFEASIBLE) | (proven & ~found)
     if bad.any():
@@ -120,3 +110,11 @@ def solve_components(problem: Any, T: np.ndarray, csizes: np.ndarray, sp: Any,
                 "stopped by the time limit")
         return comps[:0]
     return comps[stopped]
+
+
+def _candidates(sp: Any, comps: np.ndarray, kp: np.ndarray, pos: np.ndarray
+                ) -> np.ndarray:
+    """The problem's candidates at batch positions ``pos`` (the batch holds
+    ``comps``' candidates in ``sp.order``, component ``j`` from ``kp[j]``)."""
+    j = np.searchsorted(kp, pos, side="right") - 1
+    return sp.order[sp.ptr[comps[j]] + pos - kp[j]]

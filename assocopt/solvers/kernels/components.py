@@ -14,7 +14,7 @@ from __future__ import annotations
 import numpy as np
 from .jit import njit
 
-__all__ = ["split_rows", "local_rows", "labels"]
+__all__ = ["split_rows", "local_rows", "labels", "scan_parts", "gather_parts"]
 
 
 @njit(cache=True, nogil=True)
@@ -110,3 +110,51 @@ def local_rows(T0, off, part_of_row, n_parts, axis_of_row):
             if T0[k, s] > 0:
                 T[k, s] = local[off[s] + T0[k, s] - 1]
     return T, counts
+
+
+@njit(cache=True, nogil=True)
+def scan_parts(T, off, E, axis_of_row):
+    """:func:`split_rows` and, for the batch of a decomposed solve, each row's index
+    within its component and axis (``local`` (E,), ``1..``), the components' axis
+    sizes ``(n, N)`` and whether a component holds a tuple with a dummy ``(n,)``:
+    ``(n, of_row, of_cand, order, ptr, trivial, local, csizes, gated)``."""
+    K, N = T.shape
+    n, of_row, of_cand, order, ptr, trivial = split_rows(T, off, E)
+    csizes = np.zeros((n, N), np.int64)
+    local = np.empty(E, np.int64)
+    for r in range(E):
+        p = of_row[r]
+        s = axis_of_row[r]
+        csizes[p, s] += 1
+        local[r] = csizes[p, s]
+    gated = np.zeros(n, np.bool_)
+    for k in range(K):
+        for s in range(N):
+            if T[k, s] <= 0:
+                gated[of_cand[k]] = True
+                break
+    return n, of_row, of_cand, order, ptr, trivial, local, csizes, gated
+
+
+@njit(cache=True, nogil=True)
+def gather_parts(T0, costs, off, local, order, ptr, comps):
+    """``(T, c, kp)`` of the batch kernel for components ``comps``: their candidates
+    one component after the other (in ``order``), tuples relabelled by ``local``
+    (0 stays a dummy), ``kp`` where each component starts."""
+    N = T0.shape[1]
+    C = comps.shape[0]
+    kp = np.zeros(C + 1, np.int64)
+    for j in range(C):
+        kp[j + 1] = kp[j] + ptr[comps[j] + 1] - ptr[comps[j]]
+    T = np.zeros((kp[C], N), np.int64)
+    c = np.empty(kp[C])
+    for j in range(C):
+        q = kp[j]
+        for i in range(ptr[comps[j]], ptr[comps[j] + 1]):
+            k = order[i]
+            for s in range(N):
+                if T0[k, s] > 0:
+                    T[q, s] = local[off[s] + T0[k, s] - 1]
+            c[q] = costs[k]
+            q += 1
+    return T, c, kp
