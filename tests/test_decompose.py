@@ -399,3 +399,29 @@ def test_auto_batch_runs_bnb_at_its_own_defaults(monkeypatch):
     assert seen and all(set(s) <= set(bb.DEFAULTS) and all(
         s[k] == bb.DEFAULTS[k] for k in s) for s in seen)
     assert_optimal(p, sol)
+
+
+@pytest.mark.parametrize("solver, options, want", [
+    ("auto", {}, "batch"), ("bnb", {}, "bnb"), ("bnb", {"probe_every": 7}, 7)])
+def test_the_batch_searches_every_batch_probe_every_iterations_under_auto(
+        monkeypatch, solver, options, want):
+    """``auto``'s batch runs short searches every ``BATCH_PROBE_EVERY`` iterations;
+    ``solver="bnb"`` keeps bnb's own ``probe_every`` (its default, or the one given)."""
+    pytest.importorskip("numba")
+    import assocopt.solvers.bnb.batch as bb
+    want = {"batch": bb.BATCH_PROBE_EVERY, "bnb": bb.DEFAULTS["probe_every"]}.get(want, want)
+    assert bb.BATCH_PROBE_EVERY != bb.DEFAULTS["probe_every"]
+    seen = []
+    real = bb.run_tiered
+
+    def spy(name, args, stop, **kw):
+        seen.append(args[6])                     # probe_every, as the kernel takes it
+        return real(name, args, stop, **kw)
+    monkeypatch.setattr(bb, "run_tiered", spy)
+    grid = np.stack(np.meshgrid(*[np.arange(3)] * 3, indexing="ij"), -1).reshape(-1, 3)[1:]
+    T = np.concatenate([np.where(grid > 0, grid + 2 * i, 0) for i in range(20)])
+    p = AssignmentProblem.sparse((40, 40, 40), T, np.random.default_rng(2).normal(size=len(T)))
+    sol = solve(p, solver, decompose=True, **options)
+    assert sol.info["decomposition"]["batched"] == 20
+    assert seen and set(seen) == {want}
+    assert_optimal(p, sol)

@@ -206,8 +206,9 @@ def _solve_parts(problem: AssignmentProblem, sp: Split, todo: np.ndarray,
         from ..solvers.bnb.batch import solve_components
         left = _left(opts, t0)()
         # bnb's own options only when bnb was asked for: with plain ``auto`` ``opts``
-        # holds the whole problem's choice's (lagrangian-exact's max_iter, step0, ...)
-        bnb_opts = opts if name == "bnb" else _defaults(opts)
+        # holds the whole problem's choice's (lagrangian-exact's max_iter, step0, ...,
+        # or bnb's defaults, which would override the batch's own probe_every)
+        bnb_opts = opts if requested == "bnb" else _defaults(opts)
         redo = solve_components(problem, sp, todo[fits], bnb_opts, left, out)
         n_batched = int(fits.sum()) - len(redo)
         single = np.concatenate([redo, todo[~fits]]).astype(np.int64)
