@@ -31,7 +31,7 @@ from typing import Any
 
 import numpy as np
 
-from ..problems.components import (Split, component_tuples, local_tuples, split,
+from ..problems.components import (Split, gather, local_tuples, split,
                                    subproblem as _subproblem)
 from ..solvers.kernels import routed
 from ..problems.problem import AssignmentProblem
@@ -215,20 +215,20 @@ def _solve_parts(problem: AssignmentProblem, sp: Split, todo: np.ndarray,
     elif name in GROUPED:
         small = sp.sizes[todo] <= GROUP_MAX
         single, grouped = todo[~small], todo[small]
-    jobs = [(csizes[c], sp.order[sp.ptr[c]:sp.ptr[c + 1]], 1) for c in single]
+    jobs = [(csizes[c], sp.order[sp.ptr[c]:sp.ptr[c + 1]], 1, c) for c in single]
     T = None
     if len(grouped):
         T, _ = local_tuples(problem, sp.of_row, sp.n, routed)
-        jobs.append(_group(T, csizes, sp, grouped))
-    for sizes, cand, count in jobs:
+        jobs.append(_group(T, csizes, sp, grouped) + (None,))
+    for sizes, cand, count, c in jobs:
         remaining = _left(opts, t0)()
         if remaining is not None and remaining <= 0:
             out.add(Status.TIME_LIMIT, None, None, name, count,
                     "time limit reached before this component")
             continue
-        sub = _subproblem(problem, T, sizes, cand) if T is not None else \
-            _subproblem(problem, component_tuples(problem, sp, cand), sizes, cand,
-                        gathered=True)
+        sub = _subproblem(problem, T, sizes, cand) if c is None else \
+            _subproblem(problem, gather(problem, sp, np.array([c]), routed)[0], sizes,
+                        cand, gathered=True)
         # with the batch: what it left is past bnb's caps (choose_solver would say
         # lagrangian-exact) or spent bnb's node budget
         solver = ("lagrangian-exact" if batch else _auto_choice(sub)) if plain_auto \
