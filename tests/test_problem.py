@@ -95,6 +95,24 @@ def test_n_uncovered_of_full_grids_and_of_grids_with_a_hole():
     assert p.n_uncovered == 1 and p.uncovered() == [(0, 2)]
 
 
+@settings(max_examples=60, deadline=None)
+@given(st.lists(st.integers(1, 6), min_size=2, max_size=5), st.integers(0, 10 ** 6),
+       st.floats(0.05, 1.0))
+def test_n_uncovered_counts_the_indices_no_candidate_covers(sizes, seed, keep):
+    """The one-count route of ``n_uncovered`` agrees with the per-axis sets of
+    ``uncovered()`` (asked first and second: the cached route too)."""
+    rng = np.random.default_rng(seed)
+    grid = np.stack(np.meshgrid(*[np.arange(n + 1) for n in sizes], indexing="ij"),
+                    -1).reshape(-1, len(sizes))[1:]
+    T = grid[rng.random(len(grid)) < keep]
+    if not len(T):
+        T = grid[:1]
+    p = AssignmentProblem.sparse(sizes, T, rng.normal(size=len(T)))
+    want = sum(n - len(np.unique(T[:, s][T[:, s] > 0])) for s, n in enumerate(sizes))
+    assert p.n_uncovered == want
+    assert len(p.uncovered()) == want and p.n_uncovered == want
+
+
 @pytest.mark.parametrize("cached", [False, True])
 def test_window_rows_agree_with_the_cached_rows(cached):
     """uncovered_rows, coverage_matrix and violations of a subset of the candidates

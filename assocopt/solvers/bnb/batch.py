@@ -66,20 +66,24 @@ def run_batch(T: np.ndarray, c: np.ndarray, kp: np.ndarray, sizes: np.ndarray,
     answer = (outcome, ub, lb, chosen)
 
     def args(todo: np.ndarray, cap: float) -> tuple:
-        return head + (todo, cap) + answer + (new_stop(),)
-    from ..kernels import pick
+        return head + (todo, float(cap)) + answer + (new_stop(),)
+    # the argument types never change here (options arrive parsed): the compiled
+    # kernel is handed out without typing 23 arguments again (pick_fixed)
+    from ..kernels import pick_fixed
     todo = np.arange(C, dtype=np.int64)
-    pick("batch.solve_batch", *args(todo, np.inf), work=len(T))  # compile now (timed apart)
+    pick_fixed("batch.solve_batch", *args(todo, np.inf), work=len(T))  # compile now
     if deadline is None:
         small = np.diff(kp) <= INLINE_CANDIDATES
         first = todo[small]
         a = args(first, INLINE_WORK)
-        done, _ = run_tiered("batch.solve_batch", a, a[-1], work=len(T), inline=True)
+        done, _ = run_tiered("batch.solve_batch", a, a[-1], work=len(T), inline=True,
+                             fixed=True)
         todo = np.concatenate([first[done:], todo[~small]])
         if len(todo) == 0:
             return answer, False
     a = args(todo, np.inf)
-    _, by_clock = run_tiered("batch.solve_batch", a, a[-1], work=len(T), deadline=deadline)
+    _, by_clock = run_tiered("batch.solve_batch", a, a[-1], work=len(T), deadline=deadline,
+                             fixed=True)
     return answer, by_clock
 
 
