@@ -153,6 +153,8 @@ def test_dense_rejects_bad_costs(bad, match):
     ((2, 2), [[1, -1]], [1.0], "out of range"),
     ((2, 2), [[1.5, 1]], [1.0], "non-integer"),
     ((2, 2), [[0, 0]], [1.0], "all-dummy"),
+    ((2, 2), [[0, 0], [0, 1], [1, 0]], [1.0, 1.0, 1.0], "all-dummy"),   # sorted, distinct
+    ((2, 2), [[0, 0], [0, 0]], [1.0, 1.0], "all-dummy"),      # before the duplicate
     ((2, 2), [[1, 1], [1, 1]], [1.0, 2.0], "duplicate candidate tuple"),
     ((2, -1), [[1, 0]], [1.0], "non-negative"),
     ((2,), [[1]], [1.0], "at least 2 axes"),
