@@ -191,6 +191,28 @@ def test_scan_split_and_gather_kernels_equal_numpy_routes(p):
             assert np.array_equal(a, b)
 
 
+@settings(max_examples=40, deadline=None)
+@given(side_by_side(), st.booleans(), st.integers(1, 40), st.integers(1, 40),
+       st.integers(2, 12), st.integers(4, 60))
+def test_plan_kernel_equals_numpy_route(p, bnb_rule, cap_gated, cap_plain, max_kept,
+                                        max_dense):
+    """:func:`plan`: the kernel ``plan_parts`` (compiled, and as its plain twin) picks
+    the components the numpy route picks, by both rules, and gathers the same arrays."""
+    pytest.importorskip("numba")
+    from assocopt.problems.components import plan
+    from assocopt.solvers.kernels import tiers
+    from assocopt.solvers.kernels.components import plan_parts
+    sp = split(p, scan=True)
+    rule = (bnb_rule, cap_gated, cap_plain, max_kept, max_dense)
+    want = plan(p, sp, *rule)
+    assert sorted(np.concatenate(want[:2]).tolist()) == np.flatnonzero(~sp.trivial).tolist()
+    args = (p.tuples, p.costs, p.row_offsets, sp.local, sp.order, sp.ptr, sp.csizes,
+            sp.gated, sp.trivial) + rule
+    for fn in (plan_parts, tiers.plain("components.plan_parts")):
+        for a, b in zip(fn(*args), want):
+            assert np.array_equal(a, b)
+
+
 def test_split_routes_by_the_tier_rule(monkeypatch):
     """``split(p, routed)``: the numpy route (charged to the kernel's budget) while
     interpreted, the kernel once compiled; the same split either way."""

@@ -21,7 +21,7 @@ import numpy as np
 from .problem import AssignmentProblem
 
 __all__ = ["Split", "split", "split_rows", "local_tuples", "subproblem", "gather",
-           "component_tuples"]
+           "component_tuples", "plan"]
 
 
 @dataclass(frozen=True)
@@ -147,6 +147,31 @@ def gather(problem: AssignmentProblem, sp: Split, comps: np.ndarray,
         return numpy_route(*args)
     return run("components.gather_parts", numpy_route, *args,
                work=int((sp.ptr[comps + 1] - sp.ptr[comps]).sum()))
+
+
+def plan(problem: AssignmentProblem, sp: Split, bnb_rule: bool, cap_gated: int,
+         cap_plain: int, max_kept: int, max_dense: int, run: Callable | None = None
+         ) -> tuple[np.ndarray, ...]:
+    """``(batch, rest, T, c, kp)``: the non-trivial components of ``sp`` (split with
+    ``scan=True``) a batch of the ``bnb`` kernels takes (by the rule the kernel
+    ``plan_parts`` states), the others, and :func:`gather` of ``batch``.  ``run``: as
+    for :func:`split` (the kernel ``plan_parts``)."""
+    def numpy_route(T0, costs, off, local, order, ptr, csizes, gated, trivial, bnb_rule,
+                    cap_gated, cap_plain, max_kept, max_dense):
+        todo = np.flatnonzero(~trivial)
+        top2 = np.sort(csizes[todo], axis=1)[:, -2:]
+        fits = top2.sum(axis=1) <= max_kept
+        if bnb_rule:
+            fits &= (top2[:, 0] + 1) * (top2[:, 1] + 1) <= max_dense
+        else:
+            fits &= np.diff(ptr)[todo] <= np.where(gated[todo], cap_gated, cap_plain)
+        return (todo[fits], todo[~fits]) + gather(problem, sp, todo[fits])
+    args = (problem.tuples, problem.costs, problem.row_offsets, sp.local, sp.order,
+            sp.ptr, sp.csizes, sp.gated, sp.trivial, bool(bnb_rule), int(cap_gated),
+            int(cap_plain), int(max_kept), int(max_dense))
+    if run is None:
+        return numpy_route(*args)
+    return run("components.plan_parts", numpy_route, *args, work=problem.n_candidates)
 
 
 def local_tuples(problem: AssignmentProblem, part_of_row: np.ndarray, n_parts: int,

@@ -31,7 +31,7 @@ from typing import Any
 
 import numpy as np
 
-from ..problems.components import (Split, gather, local_tuples, split,
+from ..problems.components import (Split, gather, local_tuples, plan, split,
                                    subproblem as _subproblem)
 from ..solvers.kernels import routed
 from ..problems.problem import AssignmentProblem
@@ -194,24 +194,22 @@ def _solve_parts(problem: AssignmentProblem, sp: Split, todo: np.ndarray,
     single, grouped, n_batched = todo, todo[:0], 0
     batch = (plain_auto or name == "bnb") and _numba_installed()
     if batch:
-        top2 = np.sort(csizes[todo], axis=1)[:, -2:]
-        if name == "bnb":         # bnb asked for: all that its kernels take
-            from ..solvers.bnb.backend import MAX_DENSE, MAX_KEPT
-            fits = (top2.sum(axis=1) <= MAX_KEPT) & \
-                ((top2[:, 0] + 1) * (top2[:, 1] + 1) <= MAX_DENSE)
-        else:
-            gated = sp.gated[todo]
-            fits = (sp.sizes[todo] <= bnb_cap(gated, problem.ndim)) & \
-                (top2.sum(axis=1) <= BNB_MAX_KEPT)
+        from ..solvers.bnb.backend import MAX_DENSE, MAX_KEPT
         from ..solvers.bnb.batch import solve_components
+        from .choice import BNB_MAX_CANDIDATES
+        # bnb asked for: all that its kernels take; auto: what bnb suits
+        comps, rest, *arrays = plan(
+            problem, sp, name == "bnb", int(bnb_cap(True, problem.ndim)),
+            BNB_MAX_CANDIDATES, MAX_KEPT if name == "bnb" else BNB_MAX_KEPT, MAX_DENSE,
+            routed)
         left = _left(opts, t0)()
         # bnb's own options only when bnb was asked for: with plain ``auto`` ``opts``
         # holds the whole problem's choice's (lagrangian-exact's max_iter, step0, ...,
         # or bnb's defaults, which would override the batch's own probe_every)
         bnb_opts = opts if requested == "bnb" else _defaults(opts)
-        redo = solve_components(problem, sp, todo[fits], bnb_opts, left, out)
-        n_batched = int(fits.sum()) - len(redo)
-        single = np.concatenate([redo, todo[~fits]]).astype(np.int64)
+        redo = solve_components(problem, sp, comps, bnb_opts, left, out, arrays)
+        n_batched = len(comps) - len(redo)
+        single = np.concatenate([redo, rest]).astype(np.int64)
     elif name in GROUPED:
         small = sp.sizes[todo] <= GROUP_MAX
         single, grouped = todo[~small], todo[small]

@@ -14,7 +14,8 @@ from __future__ import annotations
 import numpy as np
 from .jit import njit
 
-__all__ = ["split_rows", "local_rows", "labels", "scan_parts", "gather_parts"]
+__all__ = ["split_rows", "local_rows", "labels", "scan_parts", "gather_parts",
+           "plan_parts"]
 
 
 @njit(cache=True, nogil=True)
@@ -158,3 +159,56 @@ def gather_parts(T0, costs, off, local, order, ptr, comps):
             c[q] = costs[k]
             q += 1
     return T, c, kp
+
+
+@njit(cache=True, nogil=True)
+def plan_parts(T0, costs, off, local, order, ptr, csizes, gated, trivial, bnb_rule,
+               cap_gated, cap_plain, max_kept, max_dense):
+    """Which components the ``bnb`` batch takes, and its arrays, in one pass:
+    ``(batch, rest, T, c, kp)``.  A non-trivial component goes to the batch when its
+    two largest axes hold at most ``max_kept`` indices and, by ``bnb``'s own rule
+    (``bnb_rule``), their ``(n_a+1)(n_b+1)`` is at most ``max_dense``, else (``auto``'s)
+    it has at most ``cap_gated`` candidates (``cap_plain`` without a dummy); ``rest``:
+    the other non-trivial components; ``(T, c, kp)``: :func:`gather_parts` of
+    ``batch``."""
+    n, N = csizes.shape
+    take = np.zeros(n, np.bool_)
+    nb = 0
+    nr = 0
+    for c in range(n):
+        if trivial[c]:
+            continue
+        t1 = -1
+        t0 = -1                      # the two largest axis sizes, t1 >= t0
+        for s in range(N):
+            v = csizes[c, s]
+            if v > t1:
+                t0 = t1
+                t1 = v
+            elif v > t0:
+                t0 = v
+        ok = t0 + t1 <= max_kept
+        if bnb_rule:
+            ok = ok and (t0 + 1) * (t1 + 1) <= max_dense
+        else:
+            ok = ok and ptr[c + 1] - ptr[c] <= (cap_gated if gated[c] else cap_plain)
+        take[c] = ok
+        if ok:
+            nb += 1
+        else:
+            nr += 1
+    batch = np.empty(nb, np.int64)
+    rest = np.empty(nr, np.int64)
+    i = 0
+    j = 0
+    for c in range(n):
+        if trivial[c]:
+            continue
+        if take[c]:
+            batch[i] = c
+            i += 1
+        else:
+            rest[j] = c
+            j += 1
+    T, cb, kp = gather_parts(T0, costs, off, local, order, ptr, batch)
+    return batch, rest, T, cb, kp

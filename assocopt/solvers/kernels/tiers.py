@@ -82,6 +82,7 @@ LIMITS: dict[str, float] = {
     "components.local_rows": 100_000,
     "components.scan_parts": 100_000,
     "components.gather_parts": 100_000,
+    "components.plan_parts": 100_000,
     "sparse_lap.lap_edges": 300_000,      # edges
     "murty2d.murty": 200_000,             # solutions x matrix entries
     # candidates; a net grows with its cluster's width (dense 8 x 9: 0.11 s,
