@@ -180,14 +180,15 @@ def test_scan_split_and_gather_kernels_equal_numpy_routes(p):
     assert np.array_equal(want.gated, [has_dummy[want.of_cand == c].any()
                                        for c in range(want.n)])
     comps = np.arange(want.n, dtype=np.int64)[::-2].copy()      # any order, a subset
-    Tb, cb, kp = gather(p, want, comps)
+    Tb, cb, kp, cand_b = gather(p, want, comps)
     cand = np.concatenate([want.order[want.ptr[c]:want.ptr[c + 1]] for c in comps]
                           + [np.zeros(0, np.int64)])
     assert np.array_equal(Tb, T[cand]) and np.array_equal(cb, p.costs[cand])
     assert np.array_equal(np.diff(kp), want.sizes[comps])
+    assert np.array_equal(cand_b, cand)
     args = (p.tuples, p.costs, p.row_offsets, want.local, want.order, want.ptr, comps)
     for fn in (gather_parts, tiers.plain("components.gather_parts")):
-        for a, b in zip(fn(*args), (Tb, cb, kp)):
+        for a, b in zip(fn(*args), (Tb, cb, kp, cand)):
             assert np.array_equal(a, b)
 
 

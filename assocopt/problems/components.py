@@ -128,11 +128,12 @@ def component_tuples(problem: AssignmentProblem, sp: Split, cand: np.ndarray
 
 
 def gather(problem: AssignmentProblem, sp: Split, comps: np.ndarray,
-           run: Callable | None = None) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """``(T, c, kp)`` of the batch kernel for components ``comps`` of ``sp`` (split
-    with ``scan=True``): their candidates one component after the other, in
-    ``sp.order``, tuples relabelled within their components, ``kp`` where each
-    starts.  ``run``: as for :func:`split` (the kernel ``gather_parts``)."""
+           run: Callable | None = None) -> tuple[np.ndarray, ...]:
+    """``(T, c, kp, cand)`` of the batch kernel for components ``comps`` of ``sp``
+    (split with ``scan=True``): their candidates one component after the other, in
+    ``sp.order`` (``cand``: the problem's candidate at each position), tuples
+    relabelled within their components, ``kp`` where each starts.  ``run``: as for
+    :func:`split` (the kernel ``gather_parts``)."""
     comps = np.ascontiguousarray(comps, np.int64)
 
     def numpy_route(T0, costs, off, local, order, ptr, comps):
@@ -140,7 +141,7 @@ def gather(problem: AssignmentProblem, sp: Split, comps: np.ndarray,
         kp = np.zeros(len(comps) + 1, np.int64)
         np.cumsum(counts, out=kp[1:])
         cand = order[np.repeat(ptr[comps] - kp[:-1], counts) + np.arange(kp[-1])]
-        return component_tuples(problem, sp, cand), costs[cand], kp
+        return component_tuples(problem, sp, cand), costs[cand], kp, cand
     args = (problem.tuples, problem.costs, problem.row_offsets, sp.local, sp.order,
             sp.ptr, comps)
     if run is None:
@@ -152,7 +153,7 @@ def gather(problem: AssignmentProblem, sp: Split, comps: np.ndarray,
 def plan(problem: AssignmentProblem, sp: Split, bnb_rule: bool, cap_gated: int,
          cap_plain: int, max_kept: int, max_dense: int, run: Callable | None = None
          ) -> tuple[np.ndarray, ...]:
-    """``(batch, rest, T, c, kp)``: the non-trivial components of ``sp`` (split with
+    """``(batch, rest, T, c, kp, cand)``: the non-trivial components of ``sp`` (split with
     ``scan=True``) a batch of the ``bnb`` kernels takes (by the rule the kernel
     ``plan_parts`` states), the others, and :func:`gather` of ``batch``.  ``run``: as
     for :func:`split` (the kernel ``plan_parts``)."""

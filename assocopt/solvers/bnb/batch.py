@@ -92,14 +92,14 @@ def solve_components(problem: Any, sp: Any, comps: np.ndarray, opts: SolveOption
     """Solve components ``comps`` of the split ``sp`` (``split(..., scan=True)``) in
     one kernel call, adding their answers to ``out``
     (:class:`assocopt.solving.decompose._Outcome`); returns the components whose node
-    budget ran out, for the caller to solve alone.  ``arrays``: their ``(T, c, kp)``
-    when the caller gathered them (:func:`assocopt.problems.components.plan`)."""
+    budget ran out, for the caller to solve alone.  ``arrays``: their ``(T, c, kp,
+    cand)`` when the caller gathered them (:func:`assocopt.problems.components.plan`)."""
     import time
     from ...problems.components import gather
     from ..kernels import routed
     if len(comps) == 0:
         return comps
-    Tb, cb, kp = arrays if arrays is not None else gather(problem, sp, comps, routed)
+    Tb, cb, kp, cand = arrays if arrays is not None else gather(problem, sp, comps, routed)
     params = {k: v for k, v in opts.extra.items() if k in DEFAULTS} \
         if opts.parsed else {}
     params.pop("keep_axes", None)
@@ -112,7 +112,7 @@ def solve_components(problem: Any, sp: Any, comps: np.ndarray, opts: SolveOption
     found = np.isfinite(ub)
     ok = proven & found
     if ok.any():
-        sel = _candidates(sp, comps, kp, np.flatnonzero(chosen))
+        sel = cand[chosen.view(np.bool_)]
         out.add(Status.OPTIMAL, sel, float(ub[ok].sum()), "bnb", int(ok.sum()))
     bad = (outcome == INFEASIBLE) | (proven & ~found)
     if bad.any():
@@ -124,11 +124,3 @@ def solve_components(problem: Any, sp: Any, comps: np.ndarray, opts: SolveOption
                 "stopped by the time limit")
         return comps[:0]
     return comps[stopped]
-
-
-def _candidates(sp: Any, comps: np.ndarray, kp: np.ndarray, pos: np.ndarray
-                ) -> np.ndarray:
-    """The problem's candidates at batch positions ``pos`` (the batch holds
-    ``comps``' candidates in ``sp.order``, component ``j`` from ``kp[j]``)."""
-    j = np.searchsorted(kp, pos, side="right") - 1
-    return sp.order[sp.ptr[comps[j]] + pos - kp[j]]

@@ -139,9 +139,10 @@ def scan_parts(T, off, E, axis_of_row):
 
 @njit(cache=True, nogil=True)
 def gather_parts(T0, costs, off, local, order, ptr, comps):
-    """``(T, c, kp)`` of the batch kernel for components ``comps``: their candidates
-    one component after the other (in ``order``), tuples relabelled by ``local``
-    (0 stays a dummy), ``kp`` where each component starts."""
+    """``(T, c, kp, cand)`` of the batch kernel for components ``comps``: their
+    candidates one component after the other (in ``order``), tuples relabelled by
+    ``local`` (0 stays a dummy), ``kp`` where each component starts, ``cand`` the
+    problem's candidate at each position."""
     N = T0.shape[1]
     C = comps.shape[0]
     kp = np.zeros(C + 1, np.int64)
@@ -149,6 +150,7 @@ def gather_parts(T0, costs, off, local, order, ptr, comps):
         kp[j + 1] = kp[j] + ptr[comps[j] + 1] - ptr[comps[j]]
     T = np.zeros((kp[C], N), np.int64)
     c = np.empty(kp[C])
+    cand = np.empty(kp[C], np.int64)
     for j in range(C):
         q = kp[j]
         for i in range(ptr[comps[j]], ptr[comps[j] + 1]):
@@ -157,19 +159,20 @@ def gather_parts(T0, costs, off, local, order, ptr, comps):
                 if T0[k, s] > 0:
                     T[q, s] = local[off[s] + T0[k, s] - 1]
             c[q] = costs[k]
+            cand[q] = k
             q += 1
-    return T, c, kp
+    return T, c, kp, cand
 
 
 @njit(cache=True, nogil=True)
 def plan_parts(T0, costs, off, local, order, ptr, csizes, gated, trivial, bnb_rule,
                cap_gated, cap_plain, max_kept, max_dense):
     """Which components the ``bnb`` batch takes, and its arrays, in one pass:
-    ``(batch, rest, T, c, kp)``.  A non-trivial component goes to the batch when its
+    ``(batch, rest, T, c, kp, cand)``.  A non-trivial component goes to the batch when its
     two largest axes hold at most ``max_kept`` indices and, by ``bnb``'s own rule
     (``bnb_rule``), their ``(n_a+1)(n_b+1)`` is at most ``max_dense``, else (``auto``'s)
     it has at most ``cap_gated`` candidates (``cap_plain`` without a dummy); ``rest``:
-    the other non-trivial components; ``(T, c, kp)``: :func:`gather_parts` of
+    the other non-trivial components; ``(T, c, kp, cand)``: :func:`gather_parts` of
     ``batch``."""
     n, N = csizes.shape
     take = np.zeros(n, np.bool_)
@@ -210,5 +213,5 @@ def plan_parts(T0, costs, off, local, order, ptr, csizes, gated, trivial, bnb_ru
         else:
             rest[j] = c
             j += 1
-    T, cb, kp = gather_parts(T0, costs, off, local, order, ptr, batch)
-    return batch, rest, T, cb, kp
+    T, cb, kp, cand = gather_parts(T0, costs, off, local, order, ptr, batch)
+    return batch, rest, T, cb, kp, cand
