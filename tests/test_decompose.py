@@ -432,7 +432,8 @@ def test_the_batch_searches_every_batch_probe_every_iterations_under_auto(
     ``solver="bnb"`` keeps bnb's own ``probe_every`` (its default, or the one given)."""
     pytest.importorskip("numba")
     import assocopt.solvers.bnb.batch as bb
-    want = {"batch": bb.BATCH_PROBE_EVERY, "bnb": bb.DEFAULTS["probe_every"]}.get(want, want)
+    want = {"batch": bb.BATCH_PROBE_EVERY,
+            "bnb": bb.DEFAULTS["probe_every"]}.get(want, want)
     assert bb.BATCH_PROBE_EVERY != bb.DEFAULTS["probe_every"]
     seen = []
     real = bb.run_tiered
@@ -443,7 +444,8 @@ def test_the_batch_searches_every_batch_probe_every_iterations_under_auto(
     monkeypatch.setattr(bb, "run_tiered", spy)
     grid = np.stack(np.meshgrid(*[np.arange(3)] * 3, indexing="ij"), -1).reshape(-1, 3)[1:]
     T = np.concatenate([np.where(grid > 0, grid + 2 * i, 0) for i in range(20)])
-    p = AssignmentProblem.sparse((40, 40, 40), T, np.random.default_rng(2).normal(size=len(T)))
+    costs = np.random.default_rng(2).normal(size=len(T))
+    p = AssignmentProblem.sparse((40, 40, 40), T, costs)
     sol = solve(p, solver, decompose=True, **options)
     assert sol.info["decomposition"]["batched"] == 20
     assert seen and set(seen) == {want}

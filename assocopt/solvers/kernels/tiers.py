@@ -46,8 +46,8 @@ import types
 from typing import Any, Callable, Iterator
 
 __all__ = ["MODES", "LIMITS", "BUDGET_COLD", "BUDGET_CACHED", "BUDGET_WARM", "mode",
-           "set_mode", "warmed", "interpret", "plain", "compiled", "interpreted_seconds", "exhaust", "charge",
-           "reproducible"]
+           "set_mode", "warmed", "interpret", "plain", "compiled", "interpreted_seconds",
+           "exhaust", "charge", "reproducible"]
 
 MODES = ("auto", "compiled", "interpreted")
 
