@@ -109,14 +109,22 @@ def _scan_parts(problem: AssignmentProblem, E: int, axis_of_row: np.ndarray) -> 
     from .indexing import real_counts
     N = problem.ndim
     n, of_row, of_cand, order, ptr, trivial = split_rows(problem.entry_rows, E)
-    key = of_row * N + axis_of_row
-    srt = np.argsort(key, kind="stable")
-    counts = np.bincount(key, minlength=n * N)
-    start = np.concatenate([[0], np.cumsum(counts)[:-1]])
-    local = np.empty(E, np.int64)
-    local[srt] = np.arange(E) - start[key[srt]] + 1
+    local, counts = _local_index(of_row, n, axis_of_row, N)
     gated = np.bincount(of_cand[real_counts(problem.tuples) < N], minlength=n) > 0
     return n, of_row, of_cand, order, ptr, trivial, local, counts.reshape(n, N), gated
+
+
+def _local_index(part_of_row: np.ndarray, n_parts: int, axis_of_row: np.ndarray,
+                 N: int) -> tuple[np.ndarray, np.ndarray]:
+    """Each row's index ``1..`` within its part and axis, in row order, and the rows
+    per (part, axis), ``(n_parts * N,)``."""
+    key = part_of_row * N + axis_of_row
+    order = np.argsort(key, kind="stable")
+    counts = np.bincount(key, minlength=n_parts * N)
+    start = np.concatenate([[0], np.cumsum(counts)[:-1]])
+    local = np.empty(len(key), np.int64)
+    local[order] = np.arange(len(key)) - start[key[order]] + 1
+    return local, counts
 
 
 def component_tuples(problem: AssignmentProblem, sp: Split, cand: np.ndarray
@@ -196,12 +204,7 @@ def _local_rows(R: np.ndarray, part_of_row: np.ndarray, n_parts: int,
                 axis_of_row: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """:func:`local_tuples` in numpy."""
     N = R.shape[1]
-    key = part_of_row * N + axis_of_row
-    order = np.argsort(key, kind="stable")
-    counts = np.bincount(key, minlength=n_parts * N)
-    start = np.concatenate([[0], np.cumsum(counts)[:-1]])
-    local = np.empty(len(key), np.int64)
-    local[order] = np.arange(len(key)) - start[key[order]] + 1
+    local, counts = _local_index(part_of_row, n_parts, axis_of_row, N)
     T = np.where(R >= 0, local[np.maximum(R, 0)], 0)
     return T, counts.reshape(n_parts, N)
 

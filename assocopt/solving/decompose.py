@@ -207,7 +207,7 @@ def _solve_parts(problem: AssignmentProblem, sp: Split, todo: np.ndarray,
         # holds the whole problem's choice's (lagrangian-exact's max_iter, step0, ...,
         # or bnb's defaults, which would override the batch's own probe_every)
         bnb_opts = opts if requested == "bnb" else _defaults(opts)
-        redo = solve_components(problem, sp, comps, bnb_opts, left, out, arrays)
+        redo = solve_components(sp, comps, arrays, bnb_opts, left, out)
         n_batched = len(comps) - len(redo)
         single = np.concatenate([redo, rest]).astype(np.int64)
     elif name in GROUPED:

@@ -87,19 +87,17 @@ def run_batch(T: np.ndarray, c: np.ndarray, kp: np.ndarray, sizes: np.ndarray,
     return answer, by_clock
 
 
-def solve_components(problem: Any, sp: Any, comps: np.ndarray, opts: SolveOptions,
-                     left: float | None, out: Any, arrays: Any = None) -> np.ndarray:
+def solve_components(sp: Any, comps: np.ndarray, arrays: tuple[np.ndarray, ...],
+                     opts: SolveOptions, left: float | None, out: Any) -> np.ndarray:
     """Solve components ``comps`` of the split ``sp`` (``split(..., scan=True)``) in
     one kernel call, adding their answers to ``out``
     (:class:`assocopt.solving.decompose._Outcome`); returns the components whose node
     budget ran out, for the caller to solve alone.  ``arrays``: their ``(T, c, kp,
-    cand)`` when the caller gathered them (:func:`assocopt.problems.components.plan`)."""
+    cand)`` (:func:`assocopt.problems.components.plan` or ``gather``)."""
     import time
-    from ...problems.components import gather
-    from ..kernels import routed
     if len(comps) == 0:
         return comps
-    Tb, cb, kp, cand = arrays if arrays is not None else gather(problem, sp, comps, routed)
+    Tb, cb, kp, cand = arrays
     params = {k: v for k, v in opts.extra.items() if k in DEFAULTS} \
         if opts.parsed else {}
     params.pop("keep_axes", None)

@@ -176,8 +176,6 @@ def plan_parts(T0, costs, off, local, order, ptr, csizes, gated, trivial, bnb_ru
     ``batch``."""
     n, N = csizes.shape
     take = np.zeros(n, np.bool_)
-    nb = 0
-    nr = 0
     for c in range(n):
         if trivial[c]:
             continue
@@ -196,22 +194,7 @@ def plan_parts(T0, costs, off, local, order, ptr, csizes, gated, trivial, bnb_ru
         else:
             ok = ok and ptr[c + 1] - ptr[c] <= (cap_gated if gated[c] else cap_plain)
         take[c] = ok
-        if ok:
-            nb += 1
-        else:
-            nr += 1
-    batch = np.empty(nb, np.int64)
-    rest = np.empty(nr, np.int64)
-    i = 0
-    j = 0
-    for c in range(n):
-        if trivial[c]:
-            continue
-        if take[c]:
-            batch[i] = c
-            i += 1
-        else:
-            rest[j] = c
-            j += 1
+    batch = np.flatnonzero(take)
+    rest = np.flatnonzero(~(take | trivial))
     T, cb, kp, cand = gather_parts(T0, costs, off, local, order, ptr, batch)
     return batch, rest, T, cb, kp, cand
