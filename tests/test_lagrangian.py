@@ -151,6 +151,25 @@ def test_dominance_compiled_keys_overflow():
     assert a.tolist() == b.tolist() == [True, False, False, False, False, False]
 
 
+@pytest.mark.parametrize("N", [61, 62])
+def test_dominance_compiled_keys_at_the_int64_limit(N):
+    """2^61 keys fit, 2^62 do not: the compiled steps before the rule draw the line
+    where the numpy reference's ``_radix`` does (the reference itself loops over the
+    2^(N-1) splits of the axes: too many to run here)."""
+    pytest.importorskip("numba")
+    assert lg.reduction._radix((1,) * N)[1] == (N == 61)
+    sizes = (1,) * N
+    T = np.zeros((N + 2, N), np.int64)
+    T[np.arange(N), np.arange(N)] = 1                    # the single-index candidates
+    T[N, :2] = 1                                         # a pair: dominated by a split
+    T[N + 1, :3] = 1                                     # a triple: only by the pair
+    c = np.concatenate([np.full(N, 2.0), [1.0, 3.5]])
+    a = lg.dominated(sizes, T, c, compiled=True)
+    # the pair (1 < 2 + 2) stays; the triple (3.5 < 6 by singles) falls to the split
+    # pair + single (1 + 2) only where keys fit
+    assert not a[N] and a[N + 1] == (N == 61)
+
+
 def test_dominance_example():
     T = np.array([[1, 1, 0], [1, 0, 0], [0, 1, 0], [1, 1, 1], [0, 0, 1]])
     c = np.array([5.0, 2.0, 3.0, 6.0, 1.0])

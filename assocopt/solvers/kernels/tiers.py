@@ -76,6 +76,7 @@ LIMITS: dict[str, float] = {
     "search.dfs": 20_000,                 # candidates; stops at the budget
     "batch.solve_batch": 40_000,          # candidates of all components; stops too
     "dominance.dominated_kernel": 300_000,  # candidates
+    "dominance.dominated_all": 300_000,
     # candidates; below, the numpy route of ``problems.components`` stands in for the
     # plain twin (numpy: about 0.15 us a candidate; the twin would be 100x that)
     "components.split_rows": 100_000,

@@ -37,15 +37,15 @@ def dominated(sizes: tuple[int, ...], T: np.ndarray, c: np.ndarray,
     [True, False, False]
     """
     K, N = T.shape
-    nreal = real_counts(T)
-    multi = nreal >= 2
-    if K == 0 or not multi.any() or nreal.min() == nreal.max():
-        return np.zeros(K, bool)
     if compiled is None:
         from ..base import module_installed
         compiled = module_installed("numba")
     if compiled:
-        return _dominated_compiled(sizes, T, c, nreal)
+        return _dominated_compiled(sizes, T, c)
+    nreal = real_counts(T)
+    multi = nreal >= 2
+    if K == 0 or not multi.any() or nreal.min() == nreal.max():
+        return np.zeros(K, bool)
     real = T > 0
     single = np.flatnonzero(nreal == 1)
     S = [np.full(n + 1, np.inf) for n in sizes]
@@ -97,19 +97,13 @@ def _radix(sizes: tuple[int, ...]) -> tuple[np.ndarray, bool]:
     return (radix.astype(np.int64) if fits else np.zeros(len(sizes), np.int64)), fits
 
 
-def _dominated_compiled(sizes: tuple[int, ...], T: np.ndarray, c: np.ndarray,
-                        nreal: np.ndarray) -> np.ndarray:
-    """:func:`dominated` by the compiled kernel (same mask)."""
+def _dominated_compiled(sizes: tuple[int, ...], T: np.ndarray, c: np.ndarray
+                        ) -> np.ndarray:
+    """:func:`dominated` by the compiled kernel (same mask; the steps before the rule
+    compiled too: :func:`assocopt.solvers.kernels.dominance.dominated_all`)."""
     from ..kernels import pick
-    N = T.shape[1]
-    off = np.concatenate([[0], np.cumsum(sizes)[:-1]]).astype(np.int64)
-    single_cost = np.full(int(sum(sizes)), np.inf)
-    one = np.flatnonzero(nreal == 1)
-    axis = (T[one] > 0).argmax(axis=1)
-    single_cost[off[axis] + T[one, axis] - 1] = c[one]
-    radix, fits = _radix(sizes)
-    args = (np.ascontiguousarray(T, np.int64), np.ascontiguousarray(c, np.float64), off,
-            radix, single_cost, fits)
-    kernel = pick("dominance.dominated_kernel", *args, work=len(T))
+    args = (np.ascontiguousarray(T, np.int64), np.ascontiguousarray(c, np.float64),
+            np.asarray(sizes, np.int64))
+    kernel = pick("dominance.dominated_all", *args, work=len(T))
     with np.errstate(over="ignore"):     # the hash wraps (run as Python: numpy warns)
         return kernel(*args)

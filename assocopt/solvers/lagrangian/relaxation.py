@@ -119,6 +119,16 @@ class _Relaxation:
             self.dense = np.full((na, nb), np.inf)
             self.dense_flat = self.pr * nb + self.pc
         self.kern = sparse_kernels(self, _Eval)   # gated scans: compiled, else None
+        self._last: tuple[np.ndarray, _Eval] | None = None   # (multipliers, evaluation)
+
+    def _evaluated(self, upad: np.ndarray) -> _Eval:
+        """The compiled route's evaluation at ``upad``: the last one when it was at the
+        same multipliers (the fixing probe runs at the ascent's best multipliers, most
+        often those it has just evaluated), else a new one."""
+        last = self._last
+        if last is not None and np.array_equal(last[0], upad):
+            return last[1]
+        return self.evaluate(upad, full_rc=True)
 
     def initial_multipliers(self) -> np.ndarray:
         """Each relaxed index gets the least per-index share ``c_k / (real indices of
@@ -185,6 +195,7 @@ class _Relaxation:
         nf = self.nf
         rc = None
         if self.kern is not None and (ev := self.kern.evaluate(upad)) is not None:
+            self._last = (upad.copy(), ev)
             return ev
         if self.uniform and not full_rc:
             w = np.zeros(self.m)
@@ -312,9 +323,9 @@ class _Relaxation:
         (``red >= 0``: LAP-dual reduced costs, ``max(rc, 0)`` for the candidates free
         in the relaxation), and ``lb[k] >= base + red[k]`` bounds any ``S`` holding k.
         """
-        ev = self.evaluate(upad, full_rc=True)
         if self.kern is not None:               # gated: one compiled call
-            return self.kern.fixing(ev, upad)
+            return self.kern.fixing(self._evaluated(upad), upad)
+        ev = self.evaluate(upad, full_rc=True)
         rc, gmin, na, nb = ev.rc, ev.gmin, self.na, self.nb
         cor, roc = ev.assignment.col_of_row, ev.assignment.row_of_col
         pw = gmin[self.pair_g]
