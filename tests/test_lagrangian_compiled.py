@@ -197,3 +197,51 @@ def test_window_search_stops_at_a_proven_floor(p, above, compiled):
         assert z == pytest.approx(ref.objective, abs=1e-9)
     elif above == 1e9 and p.n_candidates > 1:
         assert z <= floor                              # the first cover found ends it
+
+
+@settings(max_examples=60, deadline=None)
+@given(sd_problems(dummies=True), st.integers(0, 2 ** 32 - 1), st.sampled_from([0, 1, 2]))
+def test_window_search_with_forced_candidates_is_exact(p, seed, where):
+    """The compiled window search takes the candidates forced below its limit before
+    it branches: with any valid fixing bounds (``red >= 0``, ``base`` the optimum of
+    ``c - red``) it still finds the optimum when that is below the cap, and nothing
+    below the cap when it is not."""
+    ref = solve(p, "bruteforce")
+    if ref.status is not Status.OPTIMAL:
+        return
+    from assocopt.solvers.lagrangian.window import _compiled_search
+    rng = np.random.default_rng(seed)
+    red = rng.random(p.n_candidates) * rng.choice([0.0, 1.0, 3.0])
+    q = AssignmentProblem.sparse(p.sizes, p.tuples, p.costs - red)
+    base = solve(q, "bruteforce").objective
+    cap = [np.inf, ref.objective + 0.05, ref.objective][where]
+    sel, complete = _compiled_search(p, np.arange(p.n_candidates), red, base, cap,
+                                     False, 100_000)
+    assert complete
+    if ref.objective < cap - 1e-9 * max(1.0, abs(ref.objective)):
+        assert sel is not None and p.violations(sel) is None
+        assert p.objective_of(sel) == pytest.approx(ref.objective, abs=1e-9)
+    else:
+        assert sel is None or p.objective_of(sel) >= cap - 1e-9
+
+
+def test_force_window_takes_chains_and_finds_dead_rows():
+    """Unit propagation: a row with one candidate forces it, which drops its rivals
+    and forces the next; a row left with none means no cover below the limit."""
+    from assocopt.solvers.kernels.forcing import force_window
+    sizes = np.array([2, 2], np.int64)
+    off = np.array([0, 2], np.int64)
+    # rows a1 a2 b1 b2; (1,1) is a1's only candidate -> drops (0,1): b1 done; then
+    # a2 has (2,2) and (2,0), b2 has (2,2) and (0,2): nothing more is forced
+    T = np.array([[1, 1], [0, 1], [2, 2], [2, 0], [0, 2]], np.int64)
+    status, forced, rest, T2, sizes2 = force_window(T, off, sizes, np.zeros(5), 1.0)
+    assert status == 0 and forced.tolist() == [0]
+    assert rest.tolist() == [2, 3, 4] and sizes2.tolist() == [1, 1]
+    assert T2.tolist() == [[1, 1], [1, 0], [0, 1]]
+    # (2,0) and (0,2) above the limit: a2 and b2 keep only (2,2), forced too
+    rp = np.array([0.0, 0.0, 0.0, 5.0, 5.0])
+    status, forced, rest, _, _ = force_window(T, off, sizes, rp, 1.0)
+    assert status == 0 and sorted(forced.tolist()) == [0, 2] and len(rest) == 0
+    # (2,2) above it as well: b2's (0,2) is gone and so is every candidate of a2's
+    rp = np.array([0.0, 0.0, 5.0, 5.0, 0.0])
+    assert force_window(T, off, sizes, rp, 1.0)[0] == 1

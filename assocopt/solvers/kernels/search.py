@@ -69,7 +69,7 @@ def _select(blocked, rp, ptr, lst, axis_of, covered, slack, rem):
 
 @njit(cache=True, nogil=True)
 def dfs(G, c, rp, base, ptr, lst, axis_of, n_axes, int_costs, tol, ub, best_sel,
-        best_len, budget, stop, floor):
+        best_len, budget, stop, floor, c0=0.0):
     """Depth-first exact-cover search for a solution cheaper than ``ub``.
 
     Stops as if the node budget were spent when ``stop[0]`` is set non-zero (checked
@@ -84,20 +84,22 @@ def dfs(G, c, rp, base, ptr, lst, axis_of, n_axes, int_costs, tol, ub, best_sel,
     bound proven elsewhere (-inf if none); a solution that reaches it ends the search
     at once (the last window of ``lagrangian-exact`` otherwise proved again what the
     smaller windows before it had: Balas-Saltzman n = 22-26, 10-27 ms a window).
+    ``c0``: a cost every cover adds (candidates taken before the search, whose rows
+    are not in ``G``: :func:`.forcing.force_window`).
 
     Up to ``WORD * MAX_WORDS`` rows (a tracking scan's components), the search of
     :func:`_dfs_bits`: the same tree, cheaper nodes.
     """
     if ptr.shape[0] - 1 <= WORD * MAX_WORDS:
         return _dfs_bits(G, c, rp, base, ptr, lst, axis_of, n_axes, int_costs, tol, ub,
-                         best_sel, best_len, budget, stop, floor)
+                         best_sel, best_len, budget, stop, floor, c0)
     return _dfs_counts(G, c, rp, base, ptr, lst, axis_of, n_axes, int_costs, tol, ub,
-                       best_sel, best_len, budget, stop, floor)
+                       best_sel, best_len, budget, stop, floor, c0)
 
 
 @njit(cache=True, nogil=True)
 def _dfs_counts(G, c, rp, base, ptr, lst, axis_of, n_axes, int_costs, tol, ub, best_sel,
-                best_len, budget, stop, floor):
+                best_len, budget, stop, floor, c0):
     """:func:`dfs` for any number of rows: "is it free" is a count of the chosen
     candidates that share a row with it, kept up to date by :func:`_mark`."""
     E = ptr.shape[0] - 1
@@ -158,7 +160,7 @@ def _dfs_counts(G, c, rp, base, ptr, lst, axis_of, n_axes, int_costs, tol, ub, b
         stack_k[d] = found
         nodes += 1
         if ncov == E:                               # leaf: an exact cover
-            cost = 0.0
+            cost = c0
             for t in range(d + 1):
                 cost += c[stack_k[t]]
             if cost < limit:
@@ -239,7 +241,7 @@ def _select_bits(mask, cov, rp, ptr, lst, axis_of, slack, rem):
 
 @njit(cache=True, nogil=True)
 def _dfs_bits(G, c, rp, base, ptr, lst, axis_of, n_axes, int_costs, tol, ub, best_sel,
-              best_len, budget, stop, floor):
+              best_len, budget, stop, floor, c0):
     """:func:`dfs` for at most ``WORD * MAX_WORDS`` rows: the covered rows are bit
     words, so a candidate is free when its row set misses them (one or two ANDs), and
     choosing or undoing a candidate is an OR or an AND-NOT: no blocked counts to keep
@@ -296,7 +298,7 @@ def _dfs_bits(G, c, rp, base, ptr, lst, axis_of, n_axes, int_costs, tol, ub, bes
         stack_k[d] = found
         nodes += 1
         if ncov == E:                               # leaf: an exact cover
-            cost = 0.0
+            cost = c0
             for t in range(d + 1):
                 cost += c[stack_k[t]]
             if cost < limit:
