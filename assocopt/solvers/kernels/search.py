@@ -99,7 +99,7 @@ def dfs(G, c, rp, base, ptr, lst, axis_of, n_axes, int_costs, tol, ub, best_sel,
 
 @njit(cache=True, nogil=True)
 def _dfs_counts(G, c, rp, base, ptr, lst, axis_of, n_axes, int_costs, tol, ub, best_sel,
-                best_len, budget, stop, floor, c0):
+                best_len, budget, stop, floor, c0=0.0):
     """:func:`dfs` for any number of rows: "is it free" is a count of the chosen
     candidates that share a row with it, kept up to date by :func:`_mark`."""
     E = ptr.shape[0] - 1
@@ -241,7 +241,7 @@ def _select_bits(mask, cov, rp, ptr, lst, axis_of, slack, rem):
 
 @njit(cache=True, nogil=True)
 def _dfs_bits(G, c, rp, base, ptr, lst, axis_of, n_axes, int_costs, tol, ub, best_sel,
-              best_len, budget, stop, floor, c0):
+              best_len, budget, stop, floor, c0=0.0):
     """:func:`dfs` for at most ``WORD * MAX_WORDS`` rows: the covered rows are bit
     words, so a candidate is free when its row set misses them (one or two ANDs), and
     choosing or undoing a candidate is an OR or an AND-NOT: no blocked counts to keep
