@@ -234,14 +234,17 @@ def test_force_window_takes_chains_and_finds_dead_rows():
     # rows a1 a2 b1 b2; (1,1) is a1's only candidate -> drops (0,1): b1 done; then
     # a2 has (2,2) and (2,0), b2 has (2,2) and (0,2): nothing more is forced
     T = np.array([[1, 1], [0, 1], [2, 2], [2, 0], [0, 2]], np.int64)
-    status, forced, rest, T2, sizes2 = force_window(T, off, sizes, np.zeros(5), 1.0)
-    assert status == 0 and forced.tolist() == [0]
+    c = np.array([1.0, 2.0, 3.0, 4.0, 5.0])
+    status, forced, rest, T2, sizes2, c0, _ = force_window(T, c, off, sizes, np.zeros(5),
+                                                          1.0)
+    assert status == 0 and forced.tolist() == [0] and c0 == 1.0
     assert rest.tolist() == [2, 3, 4] and sizes2.tolist() == [1, 1]
     assert T2.tolist() == [[1, 1], [1, 0], [0, 1]]
     # (2,0) and (0,2) above the limit: a2 and b2 keep only (2,2), forced too
     rp = np.array([0.0, 0.0, 0.0, 5.0, 5.0])
-    status, forced, rest, _, _ = force_window(T, off, sizes, rp, 1.0)
+    status, forced, rest, _, _, c0, _ = force_window(T, c, off, sizes, rp, 1.0)
     assert status == 0 and sorted(forced.tolist()) == [0, 2] and len(rest) == 0
+    assert c0 == 4.0
     # (2,2) above it as well: b2's (0,2) is gone and so is every candidate of a2's
     rp = np.array([0.0, 0.0, 5.0, 5.0, 0.0])
-    assert force_window(T, off, sizes, rp, 1.0)[0] == 1
+    assert force_window(T, c, off, sizes, rp, 1.0)[0] == 1

@@ -50,21 +50,22 @@ def _rows_csr(T, off, E, alive):
 def _none(N, sizes):
     """:func:`force_window`'s answer when no cover below the limit exists."""
     e = np.empty(0, np.int64)
-    return 1, e, e.copy(), np.zeros((0, N), np.int64), sizes.copy()
+    return 1, e, e.copy(), np.zeros((0, N), np.int64), sizes.copy(), 0.0, 0.0
 
 
 @njit(cache=True, nogil=True)
-def force_window(T, off, sizes, rp, slack):
+def force_window(T, c, off, sizes, rp, slack):
     """Unit propagation over the candidates with ``rp < slack`` (the others cannot be
     in a cover below the limit: ``slack`` = limit - base).
 
-    ``T`` (K, N) the window's tuples (the problem's indices, 0 = dummy), ``off`` the
-    row of index 1 of each axis, ``sizes`` (N,) the axis sizes.  Returns ``(status,
-    forced, rest, T_rest, sizes_rest)``: ``status`` 1 when some row is left without a
-    candidate (no cover below the limit exists), else 0; ``forced`` the candidates
-    every such cover uses (in the order taken); ``rest`` the candidates still free
-    (ascending), ``T_rest`` their tuples renumbered over the uncovered rows of each
-    axis (1..``sizes_rest[s]``).
+    ``T`` (K, N) the window's tuples (the problem's indices, 0 = dummy) and ``c``
+    their costs, ``off`` the row of index 1 of each axis, ``sizes`` (N,) the axis
+    sizes.  Returns ``(status, forced, rest, T_rest, sizes_rest, c0, r0)``: ``status``
+    1 when some row is left without a candidate (no cover below the limit exists),
+    else 0; ``forced`` the candidates every such cover uses (in the order taken) and
+    ``c0``, ``r0`` the sums of their ``c`` and ``rp`` in that order; ``rest`` the
+    candidates still free (ascending), ``T_rest`` their tuples renumbered over the
+    uncovered rows of each axis (1..``sizes_rest[s]``).
     """
     K, N = T.shape
     E = 0
@@ -145,4 +146,9 @@ def force_window(T, off, sizes, rp, slack):
                 if T[k, s] > 0:
                     T_rest[m, s] = new[off[s] + T[k, s] - 1]
             m += 1
-    return 0, forced[:nf].copy(), rest, T_rest, sizes_rest
+    c0 = 0.0
+    r0 = 0.0
+    for q in range(nf):
+        c0 += c[forced[q]]
+        r0 += rp[forced[q]]
+    return 0, forced[:nf].copy(), rest, T_rest, sizes_rest, c0, r0

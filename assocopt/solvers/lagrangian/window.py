@@ -109,15 +109,12 @@ def _compiled_search(problem: AssignmentProblem, pos: np.ndarray, red: np.ndarra
     work = len(pos)                          # small: the kernels may run interpreted
     limit = kern.pick_fixed(kern.name("improve_limit"), cap, integer, OPT_TOL,
                             work=work)(cap, integer, OPT_TOL)
-    args = (T, problem.row_offsets, sizes, rp, limit - base)
-    status, forced, rest, T2, sizes2 = kern.pick_fixed("forcing.force_window", *args,
-                                                       work=work)(*args)
+    args = (T, c, problem.row_offsets, sizes, rp, limit - base)
+    status, forced, rest, T2, sizes2, c0, r0 = kern.pick_fixed(
+        "forcing.force_window", *args, work=work)(*args)
     if status:                               # a row has no candidate below the limit
         return None, True
-    c0 = 0.0
-    for k in forced.tolist():                # in the search's order: a leaf's cost
-        c0 += float(c[k])
-    base2 = base + float(rp[forced].sum())
+    base2 = base + r0
     if len(rest) == 0:                       # the forced candidates cover every row
         return (pos[np.sort(forced)] if c0 < limit else None), True
     c2, rp2 = c[rest], rp[rest]
