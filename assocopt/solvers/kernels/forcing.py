@@ -5,11 +5,12 @@ limit among the candidates that reduced-cost fixing left.  Many rows of such a w
 hold a single candidate below the limit: every cover that the search may accept uses
 it, so it is taken at once, the candidates that share a row with it are dropped, and
 that may leave further rows with one candidate.  :func:`force_window` repeats this to
-the end and hands the search what is left, with the rows renumbered: on a gated
+the end and hands the search what is left, with the rows renumbered
+(:func:`window_lists`: with the search's row lists, in one call): on a gated
 N = 4 scan's window of 419 candidates over 443 rows, 102 candidates were forced and
 206 over 163 rows were left, and each search node scans every uncovered row.
 
-May import: numpy and the kernels' :mod:`.jit` only.
+May import: numpy and the kernels' :mod:`.jit` and :mod:`.relaxation`.
 """
 
 from __future__ import annotations
@@ -17,8 +18,9 @@ from __future__ import annotations
 import numpy as np
 
 from .jit import njit
+from .relaxation import prepare, sort_lists
 
-__all__ = ["force_window"]
+__all__ = ["force_window", "window_lists"]
 
 
 @njit(cache=True, nogil=True)
@@ -152,3 +154,25 @@ def force_window(T, c, off, sizes, rp, slack):
         c0 += c[forced[q]]
         r0 += rp[forced[q]]
     return 0, forced[:nf].copy(), rest, T_rest, sizes_rest, c0, r0
+
+
+@njit(cache=True, nogil=True)
+def window_lists(T, c, off, sizes, rp, slack):
+    """:func:`force_window`, then the search's arrays over what is left (as
+    ``prepare`` and ``sort_lists`` give them).  Returns ``(status, forced, rest, c0,
+    r0, G, ptr, lst, axis_of, c_rest, rp_rest)``; the lists hold the candidates of
+    ``rest`` (by their place in it) below the slack left, ``slack - r0``."""
+    status, forced, rest, T2, sizes2, c0, r0 = force_window(T, c, off, sizes, rp, slack)
+    N = T.shape[1]
+    off2 = np.zeros(N, np.int64)
+    for s in range(1, N):
+        off2[s] = off2[s - 1] + sizes2[s - 1]
+    m = rest.shape[0]
+    c2 = np.empty(m)
+    rp2 = np.empty(m)
+    for q in range(m):
+        c2[q] = c[rest[q]]
+        rp2[q] = rp[rest[q]]
+    G, ptr, lst, _, axis_of, _, _ = prepare(T2, off2, sizes2, c2, 0, 1)
+    sptr, slst = sort_lists(ptr, lst, rp2, slack - r0)
+    return status, forced, rest, c0, r0, G, sptr, slst, axis_of, c2, rp2

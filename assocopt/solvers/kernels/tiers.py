@@ -74,7 +74,7 @@ LIMITS: dict[str, float] = {
     "relaxation.sort_lists": 100_000,
     "driver.solve": 20_000,               # candidates; stops at the budget
     "search.dfs": 20_000,                 # candidates; stops at the budget
-    "forcing.force_window": 100_000,      # candidates
+    "forcing.window_lists": 100_000,      # candidates
     "batch.solve_batch": 40_000,          # candidates of all components; stops too
     "dominance.dominated_kernel": 300_000,  # candidates
     "dominance.dominated_all": 300_000,

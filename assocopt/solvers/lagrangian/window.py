@@ -97,7 +97,7 @@ def _compiled_search(problem: AssignmentProblem, pos: np.ndarray, red: np.ndarra
     same contract, about a hundred times faster per node.
 
     The candidates every cover below the limit must use are taken first (unit
-    propagation, :func:`assocopt.solvers.kernels.forcing.force_window`) and the
+    propagation, :func:`assocopt.solvers.kernels.forcing.window_lists`) and the
     search runs on the rows they leave: on a gated N = 4 scan's 419-candidate window,
     102 forced and 163 of 443 rows left (each node scans every uncovered row)."""
     from ..bnb import kernels as kern
@@ -110,26 +110,18 @@ def _compiled_search(problem: AssignmentProblem, pos: np.ndarray, red: np.ndarra
     limit = kern.pick_fixed(kern.name("improve_limit"), cap, integer, OPT_TOL,
                             work=work)(cap, integer, OPT_TOL)
     args = (T, c, problem.row_offsets, sizes, rp, limit - base)
-    status, forced, rest, T2, sizes2, c0, r0 = kern.pick_fixed(
-        "forcing.force_window", *args, work=work)(*args)
+    status, forced, rest, c0, r0, G, sptr, slst, axis_of, c2, rp2 = kern.pick_fixed(
+        "forcing.window_lists", *args, work=work)(*args)
     if status:                               # a row has no candidate below the limit
         return None, True
-    base2 = base + r0
     if len(rest) == 0:                       # the forced candidates cover every row
         return (pos[np.sort(forced)] if c0 < limit else None), True
-    c2, rp2 = c[rest], rp[rest]
-    off2 = np.concatenate([[0], np.cumsum(sizes2)[:-1]]).astype(np.int64)
-    args = (T2, off2, sizes2, c2, 0, 1)
-    G, ptr, lst, _, axis_of, _, _ = kern.pick_fixed(kern.name("prepare"), *args,
-                                                    work=work)(*args)
-    sptr, slst = kern.pick_fixed(kern.name("sort_lists"), ptr, lst, rp2, limit - base2,
-                                 work=work)(ptr, lst, rp2, limit - base2)
-    best = np.full(int(sizes2.sum()) + 1, -1, np.int64)
+    best = np.full(len(sptr), -1, np.int64)
     from ..interruptible import new_stop
 
     stop = new_stop()
-    args = (G, c2, rp2, base2, sptr, slst, axis_of, problem.ndim, integer, OPT_TOL, cap,
-            best, -1, node_limit, stop, float(floor), c0)
+    args = (G, c2, rp2, base + r0, sptr, slst, axis_of, problem.ndim, integer, OPT_TOL,
+            cap, best, -1, node_limit, stop, float(floor), c0)
     (out, _, n, _), _ = kern.run_tiered(kern.name("dfs"), args, stop, work=work,
                                         inline=node_limit <= 20_000, fixed=True)
     sel = np.sort(np.concatenate([forced, rest[best[:n]]])) if n > 0 else None
