@@ -19,7 +19,7 @@ from ...model.solution import Status
 from ..base import Backend, RawResult, SolveOptions, register
 from ..kernels import spent
 from ..twod.lap import LapInfeasibleError
-from .ascent import _State, _ascent
+from .ascent import PROBE_LARGE, _State, _ascent
 from .compiled_ascent import _ascent_grid, applies
 from .fixing import fixing_bounds, fixing_order, make_probe
 from .local_search import _LocalSearch
@@ -28,7 +28,7 @@ from .reduction import dominated
 from .relaxation import _Relaxation
 from .policy import _OPEN_NODES, _SKIP_NODES, _SPLIT_MIN, _Skipper, _by_components, _search
 from .window import (_COMPILED_NODES, _CPSAT_BUDGET, _CPSAT_MAX, _PROBE_SEARCH_MAX,
-                     _SEARCH_MAX, _SEARCH_NODES, _cpsat,
+                     _PROBE_SEARCH_SMALL, _SEARCH_MAX, _SEARCH_NODES, _cpsat,
                      Outcome, _grow, _has_numba, _has_ortools, _ilp, _uncovered)
 
 #: Dense axial 3-AP grids run the whole ascent compiled (:mod:`.compiled_ascent`);
@@ -132,7 +132,9 @@ class _LagrangianBase(Backend):
         """Reduced-cost fixing test run now and then during the ascent (exact mode):
         stop when it proves the incumbent, or leaves a window small enough to search
         (:func:`.fixing.make_probe`)."""
-        return make_probe(rel, pos, st, problem, _has_numba(), _PROBE_SEARCH_MAX)
+        small = rel.K <= PROBE_LARGE
+        return make_probe(rel, pos, st, problem, _has_numba(),
+                          _PROBE_SEARCH_SMALL if small else _PROBE_SEARCH_MAX)
 
     def _close_gap(self, problem: AssignmentProblem, rel: _Relaxation, pos: np.ndarray,
                    upad: np.ndarray, st: _State, p: dict[str, Any], options: SolveOptions,
