@@ -63,6 +63,7 @@ def _leave_windows(mp: pytest.MonkeyPatch, nodes: int, growth: float) -> None:
     mp.setattr(lb, "_SKIP_NODES", nodes)
     mp.setattr(lw, "_SKIP_GROWTH", growth)
     mp.setattr(lb, "_PROBE_SEARCH_MAX", 0)
+    mp.setattr(lb, "_PROBE_SEARCH_SMALL", 0)
 
 
 def test_windows_left_to_larger_ones_equal_highs():
