@@ -245,3 +245,21 @@ def test_compiled_layout_equals_numpy(seed, N):
     for x, y in zip(tiers.compiled("groups.layout")(*largs),
                     tiers.plain("groups.layout")(*largs)):
         assert np.array_equal(x, y)
+
+
+@pytest.mark.parametrize("seed", range(4))
+def test_kernel_sums_are_numpys_to_the_last_bit(seed):
+    """The kernels' sum (:func:`assocopt.solvers.kernels.sums.np_sum`) repeats numpy's
+    pairwise order, so ``L(u)`` is the same float on both routes: every length up to
+    300 (the blocks of 8 and 128 and their halving) and a few long arrays, values
+    spread over six decades, compiled and as plain Python."""
+    pytest.importorskip("numba")
+    from assocopt.solvers.kernels import sums, tiers
+    plain = tiers._twin("sums")
+    rng = np.random.default_rng(seed)
+    lengths = list(range(0, 301)) + [1000, 4099, 65_537]
+    for n in lengths:
+        a = rng.normal(size=n) * 10.0 ** rng.uniform(-3, 3, n)
+        assert sums.np_sum(a) == float(np.sum(a))
+        if n <= 1000:
+            assert plain.np_sum(a) == float(np.sum(a))

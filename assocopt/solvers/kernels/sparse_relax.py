@@ -9,8 +9,8 @@ scan, most of it call overhead, and the recursive primal recovery about 1 ms (a
 ``lexsort`` and a LAP per relaxed axis).  :func:`sparse_eval` and
 :func:`sparse_recover` do each in one call, step for step as the numpy code does (the
 same edge lists in the same order, handed to the same LAP :func:`.sparse_lap.lap_edges`),
-so both give the same selections; sums the numpy code takes pairwise are left to the
-caller (``value``).
+so both give the same selections; the sums the numpy code takes pairwise (``L(u)``)
+are taken in its order (:func:`.sums.np_sum`), so the values are the same bits too.
 
 Status codes: ``0`` done, ``1`` no assignment exists (numpy: ``LapInfeasibleError``),
 ``2`` a case this kernel leaves to the numpy code (a LAP without any finite miss
@@ -23,6 +23,7 @@ import numpy as np
 
 from .jit import njit
 from .sparse_lap import lap_edges
+from .sums import np_sum
 
 __all__ = ["sparse_eval", "sparse_recover"]
 
@@ -101,9 +102,10 @@ def sparse_eval(c, U, u_off, upad, nf, g_start, g_count, gkey, na, nb,
     the multiplier slot of each candidate on relaxed axis ``t``).
 
     Returns ``(status, rc, gmin, chosen, sel, neg, subgradient, col_of_row,
-    row_of_col)``: reduced costs, group minima, the chosen groups (matched rows, then
-    missed rows, then missed columns), the relaxed solution (each chosen group's first
-    minimum, then the negative free candidates ``neg``)."""
+    row_of_col, value, free_value)``: reduced costs, group minima, the chosen groups
+    (matched rows, then missed rows, then missed columns), the relaxed solution (each
+    chosen group's first minimum, then the negative free candidates ``neg``), ``L(u)``
+    and the free candidates' part of it (summed as numpy sums them)."""
     rc = c.copy()
     for t in range(U.shape[0]):          # axis by axis: quicker than candidate-major
         for k in range(len(c)):
@@ -141,7 +143,7 @@ def sparse_eval(c, U, u_off, upad, nf, g_start, g_count, gkey, na, nb,
     g = np.zeros(u_len)
     if status != 0:
         return status, rc, gmin, np.empty(0, np.int64), np.empty(0, np.int64), neg, g, \
-            cor, roc
+            cor, roc, 0.0, 0.0
     nk = na
     for j in range(nb):
         if roc[j] < 0:
@@ -184,7 +186,15 @@ def sparse_eval(c, U, u_off, upad, nf, g_start, g_count, gkey, na, nb,
         g[x] = 1.0 - cover[x]
     for t in range(len(u_off)):
         g[u_off[t]] = 0.0
-    return 0, rc, gmin, chosen, sel, neg, g, cor, roc
+    picked = np.empty(nk)
+    for q in range(nk):
+        picked[q] = gmin[chosen[q]]
+    free = np.empty(nneg)
+    for q in range(nneg):
+        free[q] = rc[neg[q]]
+    free_value = np_sum(free)
+    value = np_sum(picked) + free_value + np_sum(upad)
+    return 0, rc, gmin, chosen, sel, neg, g, cor, roc, value, free_value
 
 
 @njit(cache=True, nogil=True)

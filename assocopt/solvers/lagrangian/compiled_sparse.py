@@ -9,8 +9,8 @@ and recovers primal solutions by the kernels of
 :mod:`assocopt.solvers.kernels.sparse_relax` instead of about forty numpy calls per
 evaluation and a lexsort plus LAP per relaxed axis per recovery.  The kernels repeat
 the numpy code step for step (the same augmented edge lists, in the same order, to the
-same compiled LAP), so the selections are identical; the sums numpy takes pairwise
-(``L(u)`` itself) are still taken by numpy here, so the values are too.
+same compiled LAP), so the selections are identical, and the sums numpy takes
+pairwise (``L(u)`` itself) are taken in numpy's order, so the values are too.
 
 Used when numba is installed and the candidate set is large enough
 (:data:`assocopt.solvers.kernels.tiers.LIMITS` ``"sparse_relax.sparse_eval"``, or
@@ -92,15 +92,14 @@ class SparseKernels:
         left to the numpy code."""
         upad = np.ascontiguousarray(upad, np.float64)
         args = (self.c, self.U, self.u_off, upad, self.nf) + self.groups + self.lap
-        status, rc, gmin, chosen, sel, neg, g, cor, roc = self._fn(EVAL, args)(*args)
+        status, rc, gmin, chosen, sel, neg, g, cor, roc, value, free_value = \
+            self._fn(EVAL, args)(*args)
         if status == 2:
             return None
         if status == 1:
             raise LapInfeasibleError("no perfect matching of the augmented edges")
-        free_value = float(rc[:self.nf][neg].sum())
-        value = float(gmin[chosen].sum()) + free_value + float(upad.sum())
         return self.result(value, sel, g, chosen, rc, gmin, Assignment2D(cor, roc, "sparse"),
-                     free_value)
+                           free_value)
 
     def fixing(self, ev: Any, upad: np.ndarray) -> tuple[np.ndarray, np.ndarray, float]:
         """``_Relaxation.fixing_bounds`` from the evaluation ``ev`` at ``upad`` (the
