@@ -263,3 +263,60 @@ def test_kernel_sums_are_numpys_to_the_last_bit(seed):
         assert sums.np_sum(a) == float(np.sum(a))
         if n <= 1000:
             assert plain.np_sum(a) == float(np.sum(a))
+
+
+def _both_routes(fn):
+    """``fn()`` with the ascent's loop compiled, then in Python (the evaluation
+    compiled in both)."""
+    from assocopt.solvers.kernels import tiers
+    from assocopt.solvers.lagrangian import sparse_ascent
+    out, runs = [], []
+    real = sparse_ascent.sparse_ascent
+
+    def counted(*args):
+        runs.append(1)
+        return real(*args)
+    for kernel in (True, False):
+        with pytest.MonkeyPatch.context() as mp:
+            mp.setattr(tiers, "_MODE", ["compiled"])
+            mp.setattr(sparse_ascent, "sparse_ascent", counted)
+            if not kernel:
+                mp.setattr(sparse_ascent, "applies", lambda *a: False)
+            before = len(runs)
+            out.append(fn())
+            assert (len(runs) > before) == kernel    # the kernel ran, or it did not
+    return out
+
+
+@pytest.mark.parametrize("seed", range(8))
+@pytest.mark.parametrize("N", [3, 4, 5])
+def test_compiled_ascent_equals_the_python_loop(seed, N):
+    """The ascent run by its kernel leaves what the Python loop leaves, to the bit:
+    multipliers, bound, incumbent, iterations, stop and step size (a plain ascent and
+    an exact one with the stall rule), and whole ``lagrangian-exact`` solves with
+    their probes and windows give the same answer after as many iterations."""
+    from assocopt.solvers.lagrangian.ascent import _ascent, _State
+    from assocopt.solvers.lagrangian.relaxation import _Relaxation
+    from assocopt.solving.decompose import TRACKING_OPTIONS
+    p = _problem(200 + seed, N)
+    params = {"max_iter": 40, "recover_every": 3, "gap_tol": 0.0, "stall_iter": 6,
+              "stall_tol": 0.01, "patience": 3, "step_decay": 0.5, "step_min": 1e-4,
+              "deflect": 0.3}
+
+    def ascent(exact):
+        def run():
+            rel = _Relaxation(p.sizes, p.tuples, p.costs, p.kept_axes(None), "sparse")
+            assert rel.kern is not None
+            st = _State(costs=p.costs, integer=p.integer_costs, theta=1.5)
+            u = _ascent(rel, np.arange(p.n_candidates)[rel.pos],
+                        rel.initial_multipliers(), st, params, None, exact)
+            return (u.tolist(), st.ub, st.bound, st.iterations, st.stop, st.theta,
+                    None if st.incumbent is None else st.incumbent.tolist())
+        return run
+    for exact in (False, True):
+        a, b = _both_routes(ascent(exact))
+        assert a == b
+    a, b = _both_routes(lambda: solve(p, "lagrangian-exact", **TRACKING_OPTIONS))
+    assert a.status == b.status and a.objective == b.objective and a.bound == b.bound
+    assert a.info["iterations"] == b.info["iterations"]
+    assert np.array_equal(a.selected, b.selected)

@@ -99,6 +99,9 @@ LIMITS: dict[str, float] = {
     # 1.2 ms at 22 000 candidates, where a cold compile costs 10 s, a load 0.4 s)
     "sparse_relax.sparse_eval": 20_000,
     "sparse_relax.sparse_recover": 20_000,
+    # candidates of the same relaxation: the ascent between its events; below, the
+    # Python loop (lagrangian.sparse_ascent)
+    "sparse_ascent.ascent_run": 20_000,
 }
 
 _MODE: list[str | None] = [None]

@@ -86,12 +86,28 @@ def _ascent(rel: _Relaxation, pos: np.ndarray, upad: np.ndarray, st: _State,
     ``min(st.ub, optimum)`` of the problem (removed candidates cannot beat the
     incumbent), so ``st.bound`` is updated with ``min(L, ub)``.
     """
+    large = int(rel.K > PROBE_LARGE)
+    next_probe, growth = PROBE_FIRST[large], PROBE_GROWTH[large]
+    if rel.kern is not None:          # the evaluation is compiled: the loop too?
+        from . import sparse_ascent as sa
+        if sa.applies(rel, deadline, ls, st):
+            return sa.sparse_ascent(rel, pos, upad, st, p, exact, probe, next_probe,
+                                    growth)
+        if deadline is None and ls is None and st.history is None:
+            return sa.charged(lambda: _loop(rel, pos, upad, st, p, deadline, exact,
+                                            ls, probe, next_probe, growth))
+    return _loop(rel, pos, upad, st, p, deadline, exact, ls, probe, next_probe, growth)
+
+
+def _loop(rel: _Relaxation, pos: np.ndarray, upad: np.ndarray, st: _State,
+          p: dict[str, Any], deadline: float | None, exact: bool,
+          ls: "_LocalSearch | None", probe: Any, next_probe: int, growth: float
+          ) -> np.ndarray:
+    """The ascent's loop in Python (:func:`_ascent`)."""
     best_L, best_u = -math.inf, upad.copy()
     since, d_prev = 0, None
     theta = st.theta
     window: list[float] = []
-    large = int(rel.K > PROBE_LARGE)
-    next_probe, growth = PROBE_FIRST[large], PROBE_GROWTH[large]
     next_ls = 0
     for it in range(int(p["max_iter"])):
         if it and deadline is not None and time.perf_counter() > deadline:
@@ -155,7 +171,7 @@ def _ascent(rel: _Relaxation, pos: np.ndarray, upad: np.ndarray, st: _State,
         target = st.ub if math.isfinite(st.ub) else \
             best_L + max(1e-3, 0.05 * abs(best_L))
         d = g if d_prev is None else g + p["deflect"] * d_prev
-        dn = float(d @ d)
+        dn = float(np.sum(d * d))        # pairwise: the kernel's sum (sparse_ascent)
         if dn <= 1e-12 * norm2:          # the deflection cancelled the subgradient
             d, dn = g, norm2
         step = theta * max(target - L, 1e-12 * max(1.0, abs(L))) / dn
