@@ -1,8 +1,10 @@
 """numba kernels of the ``bnb`` back end (its N = 3 recovery on gated problems:
-:mod:`.recovery`), the compiled window search of ``lagrangian-exact``, the dominance
-rule of both Lagrangian back ends (:mod:`.dominance`), their relaxation of a gated
-problem (:mod:`.sparse_relax`, wired by :mod:`assocopt.solvers.lagrangian.compiled_sparse`;
-the relaxed dense grid: :mod:`.grid`), the sparse 2-D LAP
+:mod:`.recovery`), the compiled window search of ``lagrangian-exact`` (its forced
+candidates first: :mod:`.forcing`), the dominance rule of both Lagrangian back ends
+(:mod:`.dominance`), their relaxation of a gated problem (:mod:`.sparse_relax`, wired
+by :mod:`assocopt.solvers.lagrangian.compiled_sparse`) and its ascent
+(:mod:`.sparse_ascent`, with numpy's sums: :mod:`.sums`; the relaxed dense grid:
+:mod:`.grid`), the sparse 2-D LAP
 (:mod:`.sparse_lap`, imported by :mod:`assocopt.solvers.twod.sparse`) and the 2-D ranking
 of :func:`assocopt.kbest` (:mod:`.sap`: a warm-startable shortest-augmenting-path LAP
 on dense matrices, :mod:`.murty2d`: Murty's method on it, imported by
@@ -18,9 +20,11 @@ of compiling it (:mod:`.tiers`).
 
 numba's disk cache does not notice a change in a kernel another file calls: after
 editing ``sap.py``, delete ``__pycache__/murty2d.*.nb[ic]`` (the same holds for
-``driver.py`` and the kernels it calls, for ``sparse_lap.py``, which
-``sparse_relax.py`` calls, and for ``grid.py`` and ``hungarian.py``, which
-``grid_ascent.py`` calls).
+``driver.py`` and the kernels it calls, for ``sparse_lap.py`` and ``sums.py``, which
+``sparse_relax.py`` calls, for ``sparse_relax.py``, which ``sparse_ascent.py`` calls,
+for ``relaxation.py``, which ``forcing.py`` calls, and for ``grid.py`` and
+``hungarian.py``, which ``grid_ascent.py`` calls).  A kernel that calls itself does
+not link from the cache at all: write recursions as loops (:func:`.sums.np_sum`).
 
 This package file itself imports no numba: it holds the clock of compilation and
 cache loading (:func:`ensure`, :func:`spent`), which :func:`assocopt.solve` reads
