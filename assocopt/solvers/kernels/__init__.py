@@ -21,9 +21,9 @@ of compiling it (:mod:`.tiers`).
 numba's disk cache does not notice a change in a kernel another file calls: after
 editing ``sap.py``, delete ``__pycache__/murty2d.*.nb[ic]`` (the same holds for
 ``driver.py`` and the kernels it calls, for ``sparse_lap.py`` and ``sums.py``, which
-``sparse_relax.py`` calls, for ``sparse_relax.py``, which ``sparse_ascent.py`` calls,
-for ``relaxation.py``, which ``forcing.py`` calls, and for ``grid.py`` and
-``hungarian.py``, which ``grid_ascent.py`` calls).  A kernel that calls itself does
+``sparse_relax.py`` calls, for ``sparse_relax.py`` and ``grid_ascent.py``, which
+``sparse_ascent.py`` calls, for ``relaxation.py``, which ``forcing.py`` calls, and for
+``grid.py`` and ``hungarian.py``, which ``grid_ascent.py`` calls).  A kernel that calls itself does
 not link from the cache at all: write recursions as loops (:func:`.sums.np_sum`).
 
 This package file itself imports no numba: it holds the clock of compilation and

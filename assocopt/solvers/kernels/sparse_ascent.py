@@ -15,13 +15,15 @@ State, shared with the caller: ``S`` (float) ``[best_L, theta, ub, bound, L,
 norm2]``, ``I`` (int) ``[it, since, has_d_prev, iterations, next_probe, n_window]``;
 ``upad``, ``best_u``, ``d_prev`` and ``window`` are updated in place.
 
-May import: numpy, the kernels' :mod:`.jit`, :mod:`.sparse_relax` and :mod:`.sums`.
+May import: numpy, the kernels' :mod:`.jit`, :mod:`.sparse_relax`, :mod:`.sums` and
+:mod:`.grid_ascent` (the dense grid's ascent: its test of the bound).
 """
 
 from __future__ import annotations
 
 import numpy as np
 
+from .grid_ascent import _closes
 from .jit import njit
 from .sparse_relax import sparse_eval
 from .sums import np_sum
@@ -35,16 +37,6 @@ EVENTS = ("infeasible", "zero", "recover", "closed", "gap_tol", "probe", "stalle
           "step_min", "max_iter")
 B_L, THETA, UB, BOUND, LVAL, NORM2 = range(6)
 IT, SINCE, HAS_D, ITERS, NEXT_PROBE, NWIN = range(6)
-
-
-@njit(cache=True, nogil=True, inline="always")
-def _closes(ub, bound, integer, tol):
-    """``_State.closes``: whether ``bound`` proves the incumbent ``ub`` optimal."""
-    if not (np.isfinite(ub) and np.isfinite(bound)):
-        return False
-    if integer:
-        return np.ceil(bound - 1e-6) >= ub
-    return bound >= ub - tol * max(1.0, abs(ub))
 
 
 @njit(cache=True, nogil=True)
@@ -100,7 +92,7 @@ def ascent_run(phase, S, I, upad, best_u, d_prev, gcur, window, c, U, u_off, nf,
             best_L = S[B_L]
             ub = S[UB]
             S[BOUND] = max(S[BOUND], min(best_L, ub))
-            if _closes(ub, best_L, integer, tol):
+            if _closes(best_L, ub, integer, tol):
                 return CLOSED, fresh, sel, chosen, g, rc, gmin, cor, roc, free_value
             if np.isfinite(ub) and gap_tol > 0 and \
                     ub - best_L <= gap_tol * max(abs(ub), 1e-12):

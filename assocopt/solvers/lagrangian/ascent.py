@@ -88,14 +88,13 @@ def _ascent(rel: _Relaxation, pos: np.ndarray, upad: np.ndarray, st: _State,
     """
     large = int(rel.K > PROBE_LARGE)
     next_probe, growth = PROBE_FIRST[large], PROBE_GROWTH[large]
-    if rel.kern is not None:          # the evaluation is compiled: the loop too?
-        from . import sparse_ascent as sa
-        if sa.applies(rel, deadline, ls, st):
+    from . import sparse_ascent as sa
+    if sa.eligible(rel, deadline, ls, st):   # the evaluation is compiled: the loop too?
+        if sa.applies(rel):
             return sa.sparse_ascent(rel, pos, upad, st, p, exact, probe, next_probe,
                                     growth)
-        if deadline is None and ls is None and st.history is None:
-            return sa.charged(lambda: _loop(rel, pos, upad, st, p, deadline, exact,
-                                            ls, probe, next_probe, growth))
+        return sa.charged(lambda: _loop(rel, pos, upad, st, p, deadline, exact, ls,
+                                        probe, next_probe, growth))
     return _loop(rel, pos, upad, st, p, deadline, exact, ls, probe, next_probe, growth)
 
 

@@ -121,6 +121,11 @@ class _Relaxation:
         self.kern = sparse_kernels(self, _Eval)   # gated scans: compiled, else None
         self._last: tuple[np.ndarray, _Eval] | None = None   # (multipliers, evaluation)
 
+    def remember(self, upad: np.ndarray, ev: _Eval) -> None:
+        """Keep ``ev``, the compiled route's evaluation at ``upad`` (a copy is kept),
+        for :meth:`_evaluated`."""
+        self._last = (upad.copy(), ev)
+
     def _evaluated(self, upad: np.ndarray) -> _Eval:
         """The compiled route's evaluation at ``upad``: the last one when it was at the
         same multipliers (the fixing probe runs at the ascent's best multipliers, most
@@ -195,7 +200,7 @@ class _Relaxation:
         nf = self.nf
         rc = None
         if self.kern is not None and (ev := self.kern.evaluate(upad)) is not None:
-            self._last = (upad.copy(), ev)
+            self.remember(upad, ev)
             return ev
         if self.uniform and not full_rc:
             w = np.zeros(self.m)

@@ -22,16 +22,20 @@ import numpy as np
 from ..twod.lap import Assignment2D, LapInfeasibleError
 from .options import OPT_TOL
 
-__all__ = ["applies", "sparse_ascent", "charged"]
+__all__ = ["eligible", "applies", "sparse_ascent", "charged"]
 
 KERNEL = "sparse_ascent.ascent_run"
 
 
-def applies(rel: Any, deadline: float | None, ls: Any, st: Any) -> bool:
-    """Whether the kernel runs this ascent (module doc)."""
-    if rel.kern is None or deadline is not None or ls is not None or \
-            st.history is not None:
-        return False
+def eligible(rel: Any, deadline: float | None, ls: Any, st: Any) -> bool:
+    """Whether the kernel can run this ascent: the evaluation compiled, no deadline,
+    local search or history (module doc)."""
+    return rel.kern is not None and deadline is None and ls is None and \
+        st.history is None
+
+
+def applies(rel: Any) -> bool:
+    """Whether the kernel runs an eligible ascent now (:mod:`..kernels.tiers`)."""
     from ..kernels import tiers
     return not tiers.interpret(KERNEL, rel.K, _cached)
 
@@ -85,8 +89,8 @@ def sparse_ascent(rel: Any, pos: np.ndarray, upad: np.ndarray, st: Any,
         event, fresh, sel, chosen, g, rc, gmin, cor, roc, free = fn(*args)
         st.bound, st.iterations = float(S[K.BOUND]), int(I[K.ITERS])
         if fresh and event != K.MAX_ITER:        # the fixing probe's evaluation
-            rel._last = (u.copy(), _Eval(float(S[K.LVAL]), sel, g, chosen, rc, gmin,
-                                         Assignment2D(cor, roc, "sparse"), free))
+            rel.remember(u, _Eval(float(S[K.LVAL]), sel, g, chosen, rc, gmin,
+                                  Assignment2D(cor, roc, "sparse"), free))
         if event == K.INFEASIBLE:
             raise LapInfeasibleError("no perfect matching of the augmented edges")
         if event == K.ZERO:                      # relaxed solution feasible: optimal
